@@ -1,0 +1,2 @@
+//! Geometry (stub; the geometry work replaces this file).
+pub mod frame;
