@@ -1,1 +1,20 @@
-//! Colour (stub).
+//! Colour: 36-bin spectra, CIE 1931 colorimetry, sRGB conversion and named spectra.
+//!
+//! The renderer transports light as [`Spectrum`] values (380-730 nm, 10 nm bins), converts to
+//! CIE XYZ with the normalised colour matching functions in [`cie`], and to sRGB with the same
+//! matrix as Mitsuba 3 ([`rgb`]). [`named`] holds the spectra a scene file can refer to.
+
+pub mod cie;
+pub mod named;
+pub mod rgb;
+pub mod spectrum;
+
+pub use cie::{CMF, CMF_NORMALISED, bin_xyz};
+pub use named::{
+    COLOR_CHECKER_NAMES, blackbody, color_checker, d65, equal_energy, planck, reflectance_to_xyz,
+};
+pub use rgb::{
+    LINEAR_SRGB_TO_XYZ, LinearSrgb, Srgb, XYZ_TO_LINEAR_SRGB, Xyz, srgb_eotf, srgb_oetf,
+    xyz_to_linear_srgb_f64,
+};
+pub use spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Spectrum, bin_lambda_nm};
