@@ -1,9 +1,39 @@
 //! rust-v: a physically based spectral path tracer.
+//!
+//! Data flows one way: **scene file → [`scene::Scene`] → camera ray →
+//! [`integrator`] → [`film::Film`] → image**. The [`render`] module drives it:
+//! progressive passes, tiles in parallel, deterministic per-sample random numbers.
+//!
+//! # Conventions
+//! - **Units**: scene units are arbitrary; wavelengths in nm; angles in the
+//!   scene file in degrees (`fov_deg`, `sigma_deg`, `rotate_deg`).
+//! - **Frames**: right-handed world space; the camera's `up` defaults to +y.
+//!   BxDFs work in a local frame whose +z is the shading normal.
+//! - **Normals**: a hit's geometric normal points out of the solid
+//!   ([`geometry`]); a dielectric's inside is the side opposite the normal.
+//! - **Directions**: `wo` points back along the path, `wi` towards the next
+//!   vertex or the light; both away from the surface.
+//! - **pdfs** are per unit solid angle unless named `_area`.
+//! - **Spectra**: 36 bins, 380-730 nm every 10 nm ([`color`]); a pixel's XYZ is
+//!   `Σ_b L(b) · cmf(b)` normalised so the equal-energy spectrum of radiance 1 has `Y = 1`.
+//! - **Depth**: `max_bounces` counts scattering events ([`integrator`]).
+//! - **The outside medium** is vacuum, index 1 ([`bxdf`]).
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
-pub mod error;
-pub mod geometry;
-pub mod color;
 pub mod bvh;
+pub mod bxdf;
+pub mod camera;
+pub mod color;
+pub mod error;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod render;
+pub mod sampler;
+pub mod sampling;
+pub mod scene;
+pub mod spectral;
 
 pub use error::{Error, Result};

@@ -1,0 +1,168 @@
+//! Scattering models (BxDFs): the closed set of materials a surface can have.
+//!
+//! # The contract (written once, for every model)
+//! All directions are in the local shading frame, where the surface normal is
+//! `+z`; `wo` points back along the path (towards the camera side), `wi` is the
+//! sampled or queried direction; both point away from the surface and are unit.
+//! Values come for a packet of `N` wavelengths ([`Lambdas`]).
+//!
+//! - [`Bxdf::eval`]`(wo, wi)` is `f(wo, wi)` without the cosine; 0 for delta
+//!   models (their value lives only in `sample`).
+//! - [`Bxdf::sample`]`(wo, u, uc)` draws `wi` and returns `f`, the pdf of `wi`
+//!   per unit solid angle, and flags. The path weight is always
+//!   `f · |cos θi| / pdf`, for delta lobes too (they return
+//!   `f = weight / |cos θi|` and `pdf` = the probability of the lobe, as pbrt-v4).
+//! - [`Bxdf::pdf`]`(wo, wi)` is the pdf `sample` would have used (0 for delta).
+//! - A model whose sampled direction depends on wavelength is *dispersive*
+//!   ([`Bxdf::is_dispersive`]); the integrators split wavelength packets before
+//!   sampling it, and pass the single wavelength's index of refraction.
+//!
+//! Diffuse models are two-sided: they reflect into whichever hemisphere `wo`
+//! is in. The dielectric is oriented: `+z` is outside (the side the geometric
+//! normal points to), so `wo.z < 0` means the path is inside the glass.
+
+mod dielectric;
+mod fresnel;
+mod ior;
+mod lambertian;
+mod oren_nayar;
+mod specular;
+
+pub use dielectric::Dielectric;
+pub use fresnel::{fresnel_dielectric, refract};
+pub use ior::{Ior, named_glass, NAMED_GLASSES};
+pub use lambertian::Lambertian;
+pub use oren_nayar::OrenNayar;
+pub use specular::Mirror;
+
+use glam::{Vec2, Vec3};
+
+use crate::spectral::{Lambdas, Sampled};
+
+/// A sampled direction with its value and pdf.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample<const N: usize> {
+    /// The sampled direction (local frame).
+    pub wi: Vec3,
+    /// `f(wo, wi)` (for delta lobes: the lobe weight divided by |cos θi|).
+    pub f: Sampled<N>,
+    /// The pdf of `wi` per unit solid angle (for delta lobes: the lobe probability).
+    pub pdf: f32,
+    /// True when `wi` was chosen from a delta distribution (mirror, glass).
+    pub is_delta: bool,
+    /// The relative index of refraction crossed (`η_t / η_i`; 1 for reflection),
+    /// for Russian roulette's η² factor.
+    pub eta: f32,
+}
+
+/// The closed set of scattering models.
+#[derive(Clone, Debug)]
+pub enum Bxdf {
+    /// A surface that absorbs everything (for example a light's own body).
+    Black,
+    /// Ideal diffuse reflection.
+    Lambertian(Lambertian),
+    /// Rough diffuse reflection (Oren-Nayar 1994).
+    OrenNayar(OrenNayar),
+    /// Perfect specular reflection.
+    Mirror(Mirror),
+    /// A smooth dielectric interface (glass, water): Fresnel reflection and refraction.
+    Dielectric(Dielectric),
+}
+
+impl Bxdf {
+    /// `f(wo, wi)` for the packet (zero for delta models).
+    #[inline]
+    pub fn eval<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
+        match self {
+            Bxdf::Lambertian(m) => m.eval(wo, wi, lambdas),
+            Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => Sampled::splat(0.0),
+        }
+    }
+
+    /// Samples `wi` given `wo`, two uniform numbers `u` and one `uc` (lobe choice).
+    /// `lambda_nm` is the wavelength whose index of refraction a dielectric uses
+    /// (the packet's single wavelength after a split, or the reference wavelength).
+    #[inline]
+    pub fn sample<const N: usize>(
+        &self,
+        wo: Vec3,
+        u: Vec2,
+        uc: f32,
+        lambdas: &Lambdas<N>,
+        lambda_nm: f32,
+    ) -> Option<BsdfSample<N>> {
+        match self {
+            Bxdf::Black => None,
+            Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
+            Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
+            Bxdf::Mirror(m) => m.sample(wo, lambdas),
+            Bxdf::Dielectric(m) => m.sample(wo, uc, m.ior.at(lambda_nm)),
+        }
+    }
+
+    /// The pdf of sampling `wi` given `wo` (zero for delta models).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => 0.0,
+        }
+    }
+
+    /// True when the model's directions are all delta (no light sampling pays).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Bxdf::Mirror(_) | Bxdf::Dielectric(_))
+    }
+
+    /// True when `sample`'s direction depends on the wavelength.
+    #[inline]
+    pub fn is_dispersive(&self) -> bool {
+        match self {
+            Bxdf::Dielectric(d) => d.ior.is_dispersive(),
+            _ => false,
+        }
+    }
+
+    /// True when the model absorbs everything (a path ends here).
+    #[inline]
+    pub fn is_black(&self) -> bool {
+        matches!(self, Bxdf::Black)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    //! Helpers shared by the models' tests.
+    use super::*;
+    use crate::color::Spectrum;
+    use crate::sampler::Sampler;
+
+    /// Checks, for `n` samples at `wo`, that `sample` agrees with `eval` and
+    /// `pdf` for the sampled direction, and returns the albedo estimate
+    /// (mean of f |cos| / pdf) for the full spectrum.
+    pub fn check_sample_consistency(b: &Bxdf, wo: Vec3, n: usize) -> Spectrum {
+        let l = Lambdas::full();
+        let mut s = Sampler::new(3, 5, 7);
+        let mut albedo = Spectrum::ZERO;
+        for _ in 0..n {
+            let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l, 550.0) else {
+                continue;
+            };
+            assert!(bs.pdf > 0.0 && !bs.f.has_nan_or_inf(), "bad sample {bs:?}");
+            assert!((bs.wi.length() - 1.0).abs() < 1e-4);
+            if !bs.is_delta {
+                let f = b.eval(wo, bs.wi, &l);
+                for i in 0..36 {
+                    assert!((f[i] - bs.f[i]).abs() <= 1e-5 * f[i].abs().max(1.0), "eval != sample at bin {i}");
+                }
+                assert!((b.pdf(wo, bs.wi) - bs.pdf).abs() <= 1e-4 * bs.pdf);
+            }
+            let w = bs.f * (bs.wi.z.abs() / bs.pdf);
+            albedo += Spectrum(w.0);
+        }
+        albedo / n as f32
+    }
+}

@@ -1,0 +1,198 @@
+//! Integrators: from a camera ray to the colour of one sample.
+//!
+//! Three light-transport methods share one spectral machinery:
+//!
+//! | `--integrator` | paths traced | wavelengths |
+//! |---|---|---|
+//! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
+//! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
+//! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface; or `--wavelengths rgb` |
+//!
+//! Every method is written once, generically over the packet size `N`
+//! ([`crate::spectral`]), and picked once per render ([`Estimator`]) so the
+//! tile loop is monomorphic.
+//!
+//! # Depth
+//! `max_bounces` counts scattering events (reflections and refractions) on a
+//! path, as pbrt-v4's `maxdepth`: 0 shows only emitters seen directly, 1 adds
+//! direct lighting. A path of `k` bounces has `k + 1` segments, so Mitsuba's
+//! `max_depth = k + 1`. The NEE shadow ray from the `k`-th bounce is allowed.
+
+mod path;
+mod whitted;
+
+pub use path::PathTracer;
+pub use whitted::Whitted;
+
+use glam::{Vec2, Vec3};
+
+use crate::bxdf::Bxdf;
+use crate::color::Xyz;
+use crate::geometry::{Frame, Ray};
+use crate::sampler::Sampler;
+use crate::sampling::power_heuristic;
+use crate::scene::desc::{IntegratorKind, WavelengthsKind};
+use crate::scene::{Scene, Settings};
+use crate::spectral::{Lambdas, Sampled, WavelengthSampling, sample_packet};
+
+/// Computes the colour of one camera sample. Implementations are chosen once
+/// per render and the render loop is generic over them.
+pub trait Estimator: Sync {
+    /// The XYZ estimate of one sample through film position `film` (pixel units).
+    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz;
+}
+
+/// The light-transport method, with its bounce limit.
+#[derive(Clone, Copy, Debug)]
+pub enum Transport {
+    /// Whitted-style.
+    Whitted(Whitted),
+    /// Path tracing.
+    Path(PathTracer),
+}
+
+impl Transport {
+    /// Radiance along `ray` for the packet `lambdas`, as XYZ.
+    #[inline]
+    pub fn li<const N: usize>(&self, scene: &Scene, ray: Ray, lambdas: &Lambdas<N>, sampler: &mut Sampler) -> Xyz {
+        match self {
+            Transport::Whitted(w) => w.li(scene, ray, lambdas, sampler),
+            Transport::Path(p) => p.li(scene, ray, lambdas, sampler),
+        }
+    }
+}
+
+/// Full spectrum on every path (the `path` and `whitted` integrators).
+pub struct FullSpectrum(pub Transport);
+
+impl Estimator for FullSpectrum {
+    #[inline]
+    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz {
+        let ray = scene.camera.ray(film);
+        self.0.li(scene, ray, &Lambdas::full(), sampler)
+    }
+}
+
+/// A packet of `C` sampled wavelengths per camera sample (the `spectral` integrator).
+pub struct Packets<const C: usize>(pub Transport, pub WavelengthSampling);
+
+impl<const C: usize> Estimator for Packets<C> {
+    #[inline]
+    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz {
+        let ray = scene.camera.ray(film);
+        let u: [f32; C] = std::array::from_fn(|_| sampler.next_1d());
+        self.0.li(scene, ray, &sample_packet::<C>(self.1, u), sampler)
+    }
+}
+
+/// The three fixed wavelengths of the RGB mode.
+pub struct RgbWavelengths(pub Transport);
+
+impl Estimator for RgbWavelengths {
+    #[inline]
+    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz {
+        let ray = scene.camera.ray(film);
+        self.0.li(scene, ray, &Lambdas::rgb(), sampler)
+    }
+}
+
+/// Calls `f` with the estimator the settings ask for: the one place where the
+/// integrator is chosen, outside the tile loop.
+pub fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> R {
+    let whitted = Transport::Whitted(Whitted { max_bounces: settings.max_bounces });
+    let path = |disperse| Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse });
+    match settings.integrator {
+        IntegratorKind::Whitted => f.call(&FullSpectrum(whitted)),
+        IntegratorKind::Path => f.call(&FullSpectrum(path(false))),
+        IntegratorKind::Spectral => {
+            let how = match settings.wavelengths {
+                WavelengthsKind::Rgb => return f.call(&RgbWavelengths(path(true))),
+                WavelengthsKind::Hero => WavelengthSampling::Hero,
+                WavelengthsKind::Random => WavelengthSampling::Random,
+            };
+            match settings.packet_size {
+                1 => f.call(&Packets::<1>(path(true), how)),
+                2 => f.call(&Packets::<2>(path(true), how)),
+                8 => f.call(&Packets::<8>(path(true), how)),
+                _ => f.call(&Packets::<4>(path(true), how)),
+            }
+        }
+    }
+}
+
+/// A function generic over the estimator type (a closure cannot be generic).
+pub trait EstimatorFn<R> {
+    /// Runs with estimator `e`.
+    fn call<E: Estimator>(self, e: &E) -> R;
+}
+
+/// The shading context at a surface hit: the local frame and the geometric
+/// normal used to keep directions on their proper side.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Shading {
+    pub p: Vec3,
+    pub n: Vec3,
+    pub frame: Frame,
+    pub wo: Vec3,
+    /// `wo · n` in world space (the geometric side the path arrived on).
+    pub wo_n: f32,
+}
+
+impl Shading {
+    /// The shading context for a ray arriving along `dir` at point `p` with
+    /// geometric normal `n` and shading normal `ns`.
+    #[inline]
+    pub fn new(p: Vec3, n: Vec3, ns: Vec3, dir: Vec3) -> Self {
+        let frame = Frame::from_z(ns);
+        Shading { p, n, frame, wo: frame.to_local(-dir), wo_n: -dir.dot(n) }
+    }
+
+    /// True when world direction `wi` (local `wi_local`) leaves on the side of
+    /// the geometric surface that the shading frame claims: a reflection must
+    /// stay on `wo`'s side of the real surface and a transmission must cross
+    /// it. Rejecting the others prevents light leaks through shading normals.
+    #[inline]
+    pub fn consistent(&self, wi: Vec3, wi_local: Vec3) -> bool {
+        let geometric_same_side = wi.dot(self.n) * self.wo_n > 0.0;
+        let shading_same_side = wi_local.z * self.wo.z > 0.0;
+        geometric_same_side == shading_same_side
+}
+
+/// One next-event estimate at a non-delta surface: a light chosen by power, a
+/// point on it sampled by solid angle or area, a shadow ray, and the MIS
+/// weight against BSDF sampling (power heuristic) when `mis` is set.
+#[inline]
+pub(crate) fn sample_direct<const N: usize>(
+    scene: &Scene,
+    bxdf: &Bxdf,
+    sh: &Shading,
+    lambdas: &Lambdas<N>,
+    sampler: &mut Sampler,
+    mis: bool,
+) -> Sampled<N> {
+    let zero = Sampled::splat(0.0);
+    let u_light = sampler.next_1d();
+    let u = sampler.next_2d();
+    let Some((index, pmf)) = scene.choose_light(u_light) else {
+        return zero;
+    };
+    let light = &scene.lights[index];
+    let Some(ls) = light.sample_li(sh.p, u) else {
+        return zero;
+    };
+    let wi_local = sh.frame.to_local(ls.wi);
+    if !sh.consistent(ls.wi, wi_local) {
+        return zero;
+    }
+    let f = bxdf.eval(sh.wo, wi_local, lambdas);
+    if f.is_black() {
+        return zero;
+    }
+    let (shadow, t_max) = Ray::spawn_to(sh.p, sh.n, ls.point);
+    if scene.occluded(&shadow, t_max) {
+        return zero;
+    }
+    let pdf_light = pmf * ls.pdf;
+    let weight = if ls.is_delta || !mis { 1.0 } else { power_heuristic(pdf_light, bxdf.pdf(sh.wo, wi_local)) };
+    f * lambdas.sample(light.spectrum()) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+}

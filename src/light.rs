@@ -1,0 +1,232 @@
+//! Light sources: the closed set of emitters and how they are sampled.
+//!
+//! Area lights are scene objects with an `emission` (a sphere or a disk); they
+//! emit from their outer side only, like Mitsuba's `area` emitter, with
+//! radiance `L_e(λ)`. A sphere is sampled uniformly over the cone it subtends
+//! (pdf per solid angle `1 / (2π (1 − cos θmax))`, pbrt-v4 §6.2.4), a disk
+//! uniformly by area (pdf converted to solid angle: `d² / (|cos θ_l| A)`).
+//! A point light has intensity `I(λ)` and is a delta light.
+//!
+//! ```ron
+//! objects: [ (shape: Sphere(center: (-0.6, 1.7, -0.4), radius: 0.2), emission: Scaled(10, EqualEnergy)) ],
+//! lights: [ Point(position: (0, 1.9, 0), intensity: Scaled(2, D65)) ],
+//! ```
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+use crate::color::Spectrum;
+use crate::geometry::{Disk, Frame, Sphere};
+use crate::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf};
+
+/// The closed set of lights.
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// An isotropic point light of intensity `intensity` (W/sr/nm, arbitrary units).
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity per wavelength.
+        intensity: Spectrum,
+    },
+    /// A spherical area light emitting `radiance` outward.
+    Sphere {
+        /// Its shape.
+        sphere: Sphere,
+        /// Emitted radiance per wavelength.
+        radiance: Spectrum,
+    },
+    /// A one-sided disk light emitting `radiance` to the side its normal points to.
+    Disk {
+        /// Its shape.
+        disk: Disk,
+        /// Emitted radiance per wavelength.
+        radiance: Spectrum,
+    },
+}
+
+/// A direction towards a light from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point to the light point.
+    pub wi: Vec3,
+    /// The sampled point on the light.
+    pub point: Vec3,
+    /// The pdf of `wi` per unit solid angle (1 for delta lights).
+    pub pdf: f32,
+    /// Scale to apply to the light's spectrum: 1 for area lights, `1/d²` for a point light.
+    pub scale: f32,
+    /// True for a point light (no MIS with BSDF sampling).
+    pub is_delta: bool,
+}
+
+impl Light {
+    /// The spectrum emitted: radiance for area lights, intensity for point lights.
+    #[inline]
+    pub fn spectrum(&self) -> &Spectrum {
+        match self {
+            Light::Point { intensity, .. } => intensity,
+            Light::Sphere { radiance, .. } | Light::Disk { radiance, .. } => radiance,
+        }
+    }
+
+    /// Total emitted power up to the spectrum's shape (mean over bins), used to
+    /// choose among lights in proportion to power.
+    pub fn power(&self) -> f32 {
+        let mean = self.spectrum().average();
+        match self {
+            Light::Point { .. } => 4.0 * PI * mean,
+            Light::Sphere { sphere, .. } => PI * 4.0 * PI * sphere.radius * sphere.radius * mean,
+            Light::Disk { disk, .. } => PI * PI * disk.radius * disk.radius * mean,
+        }
+    }
+
+    /// Samples a direction from point `p` towards the light.
+    #[inline]
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        match self {
+            Light::Point { position, .. } => {
+                let d = *position - p;
+                let d2 = d.length_squared();
+                if d2 == 0.0 {
+                    return None;
+                }
+                Some(LightSample { wi: d / d2.sqrt(), point: *position, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
+            }
+            Light::Sphere { sphere, .. } => {
+                let to_c = sphere.center - p;
+                let d2 = to_c.length_squared();
+                let r2 = sphere.radius * sphere.radius;
+                if d2 <= r2 {
+                    // Inside a sphere that emits outward: nothing to see.
+                    return None;
+                }
+                let d = d2.sqrt();
+                let sin2_max = r2 / d2;
+                let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                let frame = Frame::from_z(to_c / d);
+                let local = uniform_cone(u, cos_max);
+                let wi = frame.to_world(local).normalize();
+                // Distance to the near intersection along wi (pbrt-v4 eq. 6.x, stable form).
+                let cos_t = local.z.min(1.0);
+                let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
+                let dist = d * cos_t - (r2 - d2 * sin2_t).max(0.0).sqrt();
+                let point = p + wi * dist;
+                Some(LightSample { wi, point, pdf: uniform_cone_pdf(cos_max), scale: 1.0, is_delta: false })
+            }
+            Light::Disk { disk, .. } => {
+                let frame = Frame::from_z(disk.normal);
+                let q = concentric_disk(u) * disk.radius;
+                let point = disk.center + frame.to_world(Vec3::new(q.x, q.y, 0.0));
+                let d = point - p;
+                let d2 = d.length_squared();
+                if d2 == 0.0 {
+                    return None;
+                }
+                let wi = d / d2.sqrt();
+                let cos_l = -wi.dot(disk.normal);
+                if cos_l <= 0.0 {
+                    return None; // the back of a one-sided light
+                }
+                let area = PI * disk.radius * disk.radius;
+                Some(LightSample { wi, point, pdf: d2 / (cos_l * area), scale: 1.0, is_delta: false })
+            }
+        }
+    }
+
+    /// The pdf per unit solid angle with which [`Light::sample_li`] from `p`
+    /// would choose the direction `wi` that hits the light at `point`.
+    #[inline]
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, point: Vec3) -> f32 {
+        match self {
+            Light::Point { .. } => 0.0,
+            Light::Sphere { sphere, .. } => {
+                let d2 = (sphere.center - p).length_squared();
+                let r2 = sphere.radius * sphere.radius;
+                if d2 <= r2 {
+                    return 0.0;
+                }
+                uniform_cone_pdf((1.0 - r2 / d2).max(0.0).sqrt())
+            }
+            Light::Disk { disk, .. } => {
+                let cos_l = -wi.dot(disk.normal);
+                if cos_l <= 0.0 {
+                    return 0.0;
+                }
+                let d2 = (point - p).length_squared();
+                d2 / (cos_l * PI * disk.radius * disk.radius)
+            }
+        }
+    }
+
+    /// The radiance leaving the light's surface at a point with geometric
+    /// normal `n` towards the direction `-dir` (zero from the back side).
+    #[inline]
+    pub fn le_scale(&self, n: Vec3, dir: Vec3) -> f32 {
+        match self {
+            Light::Point { .. } => 0.0,
+            Light::Sphere { .. } | Light::Disk { .. } => {
+                if n.dot(dir) < 0.0 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::sampler::Sampler;
+
+    /// The sphere light's pdf integrates to 1 over directions: estimate
+    /// ∫ pdf_li dω over the sphere of directions by uniform sphere sampling
+    /// (200k samples, relative std. error ≈ 1% for a cone of this size, so 4%).
+    /// Also every sampled direction hits the sphere at the returned point.
+    #[test]
+    fn sphere_light_pdf_integrates_to_one_and_samples_hit() {
+        let light = Light::Sphere { sphere: Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5), radiance: Spectrum::ONE };
+        let p = Vec3::new(0.3, 0.0, 0.1);
+        let mut s = Sampler::new(1, 1, 1);
+        let n = 200_000;
+        let mut integral = 0.0f64;
+        for _ in 0..n {
+            let w = crate::sampling::uniform_sphere(s.next_2d());
+            let hit = Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5).intersect(&Ray::new(p, w), f32::INFINITY);
+            if let Some(h) = hit {
+                integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
+            }
+        }
+        let integral = integral / n as f64;
+        assert!((integral - 1.0).abs() < 0.04, "∫pdf = {integral}");
+        for _ in 0..1000 {
+            let ls = light.sample_li(p, s.next_2d()).unwrap();
+            assert!(((ls.point - Vec3::new(0.0, 2.0, 0.0)).length() - 0.5).abs() < 1e-4);
+            assert!((ls.point - p).normalize().dot(ls.wi) > 0.99999);
+        }
+    }
+
+    /// The disk light's pdf integrates to 1 over the directions that see its front.
+    #[test]
+    fn disk_light_pdf_integrates_to_one() {
+        let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
+        let light = Light::Disk { disk: disk.clone(), radiance: Spectrum::ONE };
+        let p = Vec3::new(0.5, 0.0, -0.2);
+        let mut s = Sampler::new(2, 1, 1);
+        let n = 200_000;
+        let mut integral = 0.0f64;
+        for _ in 0..n {
+            let w = crate::sampling::uniform_sphere(s.next_2d());
+            if let Some(h) = disk.intersect(&Ray::new(p, w), f32::INFINITY) {
+                integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
+            }
+        }
+        let integral = integral / n as f64;
+        assert!((integral - 1.0).abs() < 0.04, "∫pdf = {integral}");
+        // From behind, the disk is dark and never sampled.
+        assert!(light.sample_li(Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5)).is_none());
+    }
+}

@@ -1,0 +1,292 @@
+//! The scene file format: serde structures that *are* the RON format.
+//!
+//! Every struct denies unknown fields, so a misspelt field is an error with
+//! its line:column, never silently ignored. [`super::load`] turns a
+//! [`SceneDesc`] into a [`super::Scene`], checking names and sizes.
+//!
+//! A complete example (`scenes/cornell.ron` is the full one):
+//! ```ron
+//! (
+//!     camera: (eye: (0, 1, 3.5), look_at: (0, 1, 0), up: (0, 1, 0), fov_deg: 45),
+//!     render: (width: 256, height: 256, spp: 64, seed: 0, max_bounces: 8, integrator: path),
+//!     materials: {
+//!         "white": OrenNayar(reflectance: ColorChecker("white 9.5 (.05 D)"), sigma_deg: 20),
+//!         "glass": Dielectric(ior: Named("N-BK7")),
+//!     },
+//!     objects: [
+//!         (shape: Quad(origin: (-1, 0, 1), edge_u: (2, 0, 0), edge_v: (0, 0, -2)), material: "white"),
+//!         (shape: Sphere(center: (0.3, 0.35, -0.2), radius: 0.35), material: "glass"),
+//!         (shape: Sphere(center: (-0.6, 1.7, -0.4), radius: 0.2), emission: Scaled(10, EqualEnergy)),
+//!     ],
+//!     lights: [ Point(position: (0, 1.9, 0), intensity: Constant(1)) ],
+//! )
+//! ```
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+/// A 3-vector in the file: `(x, y, z)`.
+pub type V3 = [f32; 3];
+
+/// The whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// The camera.
+    pub camera: CameraDesc,
+    /// Render settings; each can be overridden on the command line.
+    #[serde(default)]
+    pub render: RenderDesc,
+    /// Named materials, referred to by objects.
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    /// The objects (shapes with a material or an emission).
+    pub objects: Vec<ObjectDesc>,
+    /// Lights that are not objects (point lights).
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
+}
+
+/// A pinhole camera.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Position of the eye.
+    pub eye: V3,
+    /// The point looked at.
+    pub look_at: V3,
+    /// The up direction (default `(0, 1, 0)`).
+    #[serde(default = "default_up")]
+    pub up: V3,
+    /// Vertical field of view in degrees.
+    pub fov_deg: f32,
+}
+
+fn default_up() -> V3 {
+    [0.0, 1.0, 0.0]
+}
+
+/// Render settings of a scene file (all optional).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDesc {
+    /// Image width in pixels (default 512).
+    pub width: Option<u32>,
+    /// Image height in pixels (default 512).
+    pub height: Option<u32>,
+    /// Samples per pixel = passes (default 64).
+    pub spp: Option<u32>,
+    /// Random seed (default 0).
+    pub seed: Option<u64>,
+    /// Maximum number of scattering events on a path (default 8); see the crate docs.
+    pub max_bounces: Option<u32>,
+    /// Integrator: `path`, `whitted` or `spectral` (default `path`).
+    pub integrator: Option<IntegratorKind>,
+    /// Wavelength sampling of the `spectral` integrator: `hero`, `random` or `rgb` (default `hero`).
+    pub wavelengths: Option<WavelengthsKind>,
+    /// Wavelengths per packet of the `spectral` integrator: 1, 2, 4 or 8 (default 4).
+    pub packet_size: Option<u32>,
+}
+
+/// The integrators.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorKind {
+    /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
+    Path,
+    /// Whitted-style recursive ray tracing: E S* (D|G) L.
+    Whitted,
+    /// Spectral path tracing with wavelength packets that split at dispersive surfaces.
+    Spectral,
+}
+
+/// Wavelength sampling of the spectral integrator.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum WavelengthsKind {
+    /// One uniform hero bin, the others at equal rotation.
+    Hero,
+    /// Independent uniform bins.
+    Random,
+    /// Three fixed wavelengths (435.8, 546.1, 700 nm) read out as RGB.
+    Rgb,
+}
+
+/// A spectrum in the scene file.
+#[derive(Clone, Debug, Deserialize)]
+pub enum SpectrumDesc {
+    /// The same value at every wavelength: `Constant(0.5)`.
+    Constant(f32),
+    /// 36 values at 380, 390, ..., 730 nm: `Samples([0.1, 0.1, ...])`.
+    Samples(Vec<f32>),
+    /// A ColorChecker patch by its BabelColor name: `ColorChecker("red")`.
+    ColorChecker(String),
+    /// CIE illuminant D65, normalised to 1 at 560 nm.
+    D65,
+    /// The equal-energy illuminant: 1 everywhere.
+    EqualEnergy,
+    /// Planck's law at a temperature in kelvin, normalised to peak 1: `Blackbody(3000)`.
+    Blackbody(f32),
+    /// A spectrum times a factor: `Scaled(10, D65)`.
+    Scaled(f32, Box<SpectrumDesc>),
+}
+
+/// An index of refraction in the scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum IorDesc {
+    /// Constant over wavelength: `Constant(1.5)`.
+    Constant(f32),
+    /// `n = a + b / λ²`, λ in µm: `Cauchy(a: 1.5, b: 0.0042)`.
+    Cauchy {
+        /// A.
+        a: f32,
+        /// B in µm².
+        b: f32,
+    },
+    /// `n² − 1 = Σ Bᵢ λ² / (λ² − Cᵢ)`, λ in µm, three terms.
+    Sellmeier {
+        /// B₁, B₂, B₃.
+        b: V3,
+        /// C₁, C₂, C₃ in µm².
+        c: V3,
+    },
+    /// A named glass: `Named("N-BK7")` (N-BK7, N-SF11, SF11, F2, fused_silica, water_20C, diamond).
+    Named(String),
+}
+
+/// A material.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MaterialDesc {
+    /// Ideal diffuse.
+    Lambertian {
+        /// Reflectance.
+        reflectance: SpectrumDesc,
+    },
+    /// Rough diffuse; σ in degrees (0 = Lambertian).
+    OrenNayar {
+        /// Reflectance.
+        reflectance: SpectrumDesc,
+        /// Roughness σ in degrees.
+        sigma_deg: f32,
+    },
+    /// A perfect mirror.
+    Mirror {
+        /// Reflectance.
+        reflectance: SpectrumDesc,
+    },
+    /// Smooth glass.
+    Dielectric {
+        /// Index of refraction of the inside.
+        ior: IorDesc,
+    },
+    /// Absorbs everything.
+    Black,
+}
+
+/// A shape.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ShapeDesc {
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: V3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A thin spherical shell between two concentric spheres.
+    Bubble {
+        /// Centre.
+        center: V3,
+        /// Outer radius.
+        outer_radius: f32,
+        /// Inner radius (less than the outer).
+        inner_radius: f32,
+    },
+    /// An infinite plane through `point` with normal `normal`.
+    Plane {
+        /// A point on the plane.
+        point: V3,
+        /// The normal (need not be unit).
+        normal: V3,
+    },
+    /// A disk.
+    Disk {
+        /// Centre.
+        center: V3,
+        /// The normal (the emitting side for a light).
+        normal: V3,
+        /// Radius.
+        radius: f32,
+    },
+    /// An axis-aligned box as a solid.
+    Cuboid {
+        /// The minimum corner.
+        min: V3,
+        /// The maximum corner.
+        max: V3,
+    },
+    /// A parallelogram `origin + a·edge_u + b·edge_v`, a, b in [0, 1]; normal `edge_u × edge_v`.
+    Quad {
+        /// A corner.
+        origin: V3,
+        /// First edge.
+        edge_u: V3,
+        /// Second edge.
+        edge_v: V3,
+    },
+    /// A triangle mesh from an OBJ or PLY file (optionally .gz), relative to the scene file.
+    Mesh {
+        /// The mesh file.
+        path: String,
+        /// Uniform or per-axis scale (default 1).
+        #[serde(default)]
+        scale: Option<ScaleDesc>,
+        /// Rotation in degrees about x, then y, then z (default none).
+        #[serde(default)]
+        rotate_deg: Option<V3>,
+        /// Translation (default none).
+        #[serde(default)]
+        translate: Option<V3>,
+    },
+}
+
+/// A scale: one number or three.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ScaleDesc {
+    /// The same along every axis.
+    Uniform(f32),
+    /// Per axis.
+    PerAxis(V3),
+}
+
+/// An object: a shape with a material, an emission, or both.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    /// The shape.
+    pub shape: ShapeDesc,
+    /// The name of a material in `materials` (default: black, for lights).
+    #[serde(default)]
+    pub material: Option<String>,
+    /// Emitted radiance, making the object an area light (spheres and disks).
+    #[serde(default)]
+    pub emission: Option<SpectrumDesc>,
+}
+
+/// A light that is not an object.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum LightDesc {
+    /// A point light.
+    Point {
+        /// Position.
+        position: V3,
+        /// Radiant intensity.
+        intensity: SpectrumDesc,
+    },
+}

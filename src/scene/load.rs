@@ -1,0 +1,293 @@
+//! From a RON scene file to a [`Scene`]: parse, check every name and size,
+//! load meshes, and report mistakes with the file, line:column (from the RON
+//! parser) or the field path (for checks after parsing) and what was expected.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::desc::{IorDesc, LightDesc, MaterialDesc, RenderDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
+use super::{Object, Scene, Settings};
+use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, OrenNayar, named_glass, NAMED_GLASSES};
+use crate::camera::Camera;
+use crate::color::{self, N_BINS, Spectrum};
+use crate::error::{Error, Result};
+use crate::geometry::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
+use crate::light::Light;
+
+/// Loads the scene file at `path`; `overrides` (from the command line) take
+/// precedence over the file's `render` settings.
+pub fn load_scene(path: &Path, overrides: &RenderDesc) -> Result<Scene> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    load_scene_str(&text, path, overrides)
+}
+
+/// Loads a scene from its text; `path` names it in errors and anchors
+/// relative mesh paths.
+pub fn load_scene_str(text: &str, path: &Path, overrides: &RenderDesc) -> Result<Scene> {
+    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let desc: SceneDesc = options.from_str(text).map_err(|e| Error::Scene {
+        path: path.to_path_buf(),
+        position: Some((e.span.start.line, e.span.start.col)),
+        field: String::new(),
+        message: e.code.to_string(),
+    })?;
+    let ctx = Ctx { path, dir: path.parent().map(Path::to_path_buf).unwrap_or_default() };
+    build(&ctx, desc, overrides, fnv1a(text.as_bytes()))
+}
+
+/// FNV-1a 64-bit hash, for recognising a scene's content in checkpoints.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for &b in bytes {
+        h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    dir: PathBuf,
+}
+
+impl Ctx<'_> {
+    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::scene_field(self.path, field, message)
+    }
+
+    fn positive(&self, field: &str, v: f32) -> Result<f32> {
+        if v.is_finite() && v > 0.0 { Ok(v) } else { Err(self.err(field, format!("expected a positive number, found {v}"))) }
+    }
+
+    fn vec(&self, field: &str, v: V3) -> Result<Vec3> {
+        let v = Vec3::from(v);
+        if v.is_finite() { Ok(v) } else { Err(self.err(field, "expected finite coordinates")) }
+    }
+
+    fn direction(&self, field: &str, v: V3) -> Result<Vec3> {
+        let v = self.vec(field, v)?;
+        v.try_normalize().ok_or_else(|| self.err(field, "expected a non-zero direction"))
+    }
+
+    fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+        let out = match s {
+            SpectrumDesc::Constant(v) => Spectrum::splat(*v),
+            SpectrumDesc::Samples(v) => {
+                if v.len() != N_BINS {
+                    return Err(self.err(field, format!("expected 36 samples (380 to 730 nm every 10 nm), found {}", v.len())));
+                }
+                Spectrum::from_fn(|i| v[i])
+            }
+            SpectrumDesc::ColorChecker(name) => color::named::color_checker(name).ok_or_else(|| {
+                self.err(field, format!("unknown ColorChecker patch \"{name}\"; expected one of: {}", color::named::COLOR_CHECKER_NAMES.join(", ")))
+            })?,
+            SpectrumDesc::D65 => color::named::d65(),
+            SpectrumDesc::EqualEnergy => color::named::equal_energy(),
+            SpectrumDesc::Blackbody(t) => color::named::blackbody(*t)
+                .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
+            SpectrumDesc::Scaled(k, inner) => self.spectrum(field, inner)? * *k,
+        };
+        if out.has_nan_or_inf() || out.min_value() < 0.0 {
+            return Err(self.err(field, "expected finite, non-negative values"));
+        }
+        Ok(out)
+    }
+
+    fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+        let r = self.spectrum(field, s)?;
+        if r.max_value() > 1.0 {
+            return Err(self.err(field, format!("a reflectance must lie in [0, 1], found {}", r.max_value())));
+        }
+        Ok(r)
+    }
+
+    fn ior(&self, field: &str, d: &IorDesc) -> Result<Ior> {
+        let ior = match d {
+            IorDesc::Constant(n) => Ior::Constant(*n),
+            IorDesc::Cauchy { a, b } => Ior::Cauchy { a: *a, b: *b },
+            IorDesc::Sellmeier { b, c } => Ior::Sellmeier { b: [b[0], b[1], b[2], 0.0], c: [c[0], c[1], c[2], 0.0] },
+            IorDesc::Named(name) => named_glass(name).ok_or_else(|| {
+                let names: Vec<&str> = NAMED_GLASSES.iter().map(|g| g.0).collect();
+                self.err(field, format!("unknown glass \"{name}\"; expected one of: {}", names.join(", ")))
+            })?,
+        };
+        for lambda in [color::LAMBDA_MIN_NM, 550.0, color::bin_lambda_nm(N_BINS - 1)] {
+            let n = ior.at(lambda);
+            if !(n.is_finite() && n > 0.0) {
+                return Err(self.err(field, format!("the index of refraction at {lambda} nm is {n}; expected a positive number")));
+            }
+        }
+        Ok(ior)
+    }
+
+    fn material(&self, field: &str, d: &MaterialDesc) -> Result<Bxdf> {
+        Ok(match d {
+            MaterialDesc::Lambertian { reflectance } => {
+                Bxdf::Lambertian(Lambertian { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
+            }
+            MaterialDesc::OrenNayar { reflectance, sigma_deg } => {
+                if !(sigma_deg.is_finite() && (0.0..=90.0).contains(sigma_deg)) {
+                    return Err(self.err(format!("{field}.sigma_deg"), format!("expected degrees in [0, 90], found {sigma_deg}")));
+                }
+                Bxdf::OrenNayar(OrenNayar::new(self.reflectance(&format!("{field}.reflectance"), reflectance)?, *sigma_deg))
+            }
+            MaterialDesc::Mirror { reflectance } => {
+                Bxdf::Mirror(Mirror { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
+            }
+            MaterialDesc::Dielectric { ior } => Bxdf::Dielectric(Dielectric { ior: self.ior(&format!("{field}.ior"), ior)? }),
+            MaterialDesc::Black => Bxdf::Black,
+        })
+    }
+
+    fn shape(&self, field: &str, d: &ShapeDesc) -> Result<Shape> {
+        let f = |name: &str| format!("{field}.{name}");
+        Ok(match d {
+            ShapeDesc::Sphere { center, radius } => {
+                Shape::Sphere(Sphere::new(self.vec(&f("center"), *center)?, self.positive(&f("radius"), *radius)?))
+            }
+            ShapeDesc::Bubble { center, outer_radius, inner_radius } => {
+                let outer = self.positive(&f("outer_radius"), *outer_radius)?;
+                let inner = self.positive(&f("inner_radius"), *inner_radius)?;
+                if inner >= outer {
+                    return Err(self.err(f("inner_radius"), format!("expected less than outer_radius ({outer}), found {inner}")));
+                }
+                Shape::Bubble(Bubble { center: self.vec(&f("center"), *center)?, outer_radius: outer, inner_radius: inner })
+            }
+            ShapeDesc::Plane { point, normal } => {
+                Shape::Plane(Plane { point: self.vec(&f("point"), *point)?, normal: self.direction(&f("normal"), *normal)? })
+            }
+            ShapeDesc::Disk { center, normal, radius } => Shape::Disk(Disk {
+                center: self.vec(&f("center"), *center)?,
+                normal: self.direction(&f("normal"), *normal)?,
+                radius: self.positive(&f("radius"), *radius)?,
+            }),
+            ShapeDesc::Cuboid { min, max } => {
+                let (lo, hi) = (self.vec(&f("min"), *min)?, self.vec(&f("max"), *max)?);
+                if !lo.cmplt(hi).all() {
+                    return Err(self.err(field, "expected min < max on every axis"));
+                }
+                Shape::Cuboid(Cuboid { min: lo, max: hi })
+            }
+            ShapeDesc::Quad { origin, edge_u, edge_v } => {
+                let (u, v) = (self.vec(&f("edge_u"), *edge_u)?, self.vec(&f("edge_v"), *edge_v)?);
+                if u.cross(v).length_squared() <= f32::MIN_POSITIVE {
+                    return Err(self.err(field, "edge_u and edge_v must be non-zero and not parallel"));
+                }
+                Shape::Quad(Quad { origin: self.vec(&f("origin"), *origin)?, edge_u: u, edge_v: v })
+            }
+            ShapeDesc::Mesh { path, scale, rotate_deg, translate } => {
+                let scale = match scale {
+                    None => Vec3::ONE,
+                    Some(ScaleDesc::Uniform(s)) => Vec3::splat(self.positive(&f("scale"), *s)?),
+                    Some(ScaleDesc::PerAxis(s)) => {
+                        for (axis, v) in s.iter().enumerate() {
+                            self.positive(&format!("{field}.scale[{axis}]"), *v)?;
+                        }
+                        Vec3::from(*s)
+                    }
+                };
+                let transform = Transform {
+                    scale,
+                    rotate_deg: rotate_deg.map(Vec3::from).unwrap_or(Vec3::ZERO),
+                    translate: translate.map(Vec3::from).unwrap_or(Vec3::ZERO),
+                };
+                let file = self.dir.join(path);
+                Shape::Mesh(Box::new(Mesh::load(&file, &transform)?))
+            }
+        })
+    }
+}
+
+fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &RenderDesc, content_hash: u64) -> Result<Scene> {
+    let settings = settings(ctx, &desc.render, overrides)?;
+
+    // Materials by name; index 0 is the implicit black material of lights.
+    let mut materials = vec![Bxdf::Black];
+    let mut by_name = BTreeMap::new();
+    for (name, m) in &desc.materials {
+        by_name.insert(name.as_str(), materials.len() as u32);
+        materials.push(ctx.material(&format!("materials.\"{name}\""), m)?);
+    }
+
+    let mut objects = Vec::with_capacity(desc.objects.len());
+    let mut lights = Vec::new();
+    for (i, o) in desc.objects.iter().enumerate() {
+        let field = format!("objects[{i}]");
+        let shape = ctx.shape(&format!("{field}.shape"), &o.shape)?;
+        let material = match &o.material {
+            Some(name) => *by_name.get(name.as_str()).ok_or_else(|| {
+                let known: Vec<&str> = by_name.keys().copied().collect();
+                ctx.err(format!("{field}.material"), format!("unknown material \"{name}\"; defined: {}", known.join(", ")))
+            })?,
+            None if o.emission.is_some() => 0,
+            None => return Err(ctx.err(&field, "expected a `material` or an `emission`")),
+        };
+        let light = match &o.emission {
+            None => None,
+            Some(e) => {
+                let radiance = ctx.spectrum(&format!("{field}.emission"), e)?;
+                let l = match &shape {
+                    Shape::Sphere(s) => Light::Sphere { sphere: s.clone(), radiance },
+                    Shape::Disk(d) => Light::Disk { disk: d.clone(), radiance },
+                    _ => return Err(ctx.err(format!("{field}.emission"), "only Sphere and Disk shapes can emit")),
+                };
+                lights.push(l);
+                Some(lights.len() as u32 - 1)
+            }
+        };
+        objects.push(Object { shape, material, light });
+    }
+    for (i, l) in desc.lights.iter().enumerate() {
+        match l {
+            LightDesc::Point { position, intensity } => lights.push(Light::Point {
+                position: ctx.vec(&format!("lights[{i}].position"), *position)?,
+                intensity: ctx.spectrum(&format!("lights[{i}].intensity"), intensity)?,
+            }),
+        }
+    }
+    if objects.is_empty() {
+        return Err(ctx.err("objects", "expected at least one object"));
+    }
+
+    let c = &desc.camera;
+    let eye = ctx.vec("camera.eye", c.eye)?;
+    let look_at = ctx.vec("camera.look_at", c.look_at)?;
+    let up = ctx.direction("camera.up", c.up)?;
+    let forward = (look_at - eye).try_normalize().ok_or_else(|| ctx.err("camera.look_at", "must differ from camera.eye"))?;
+    if forward.cross(up).length() < 1e-4 {
+        return Err(ctx.err("camera.up", "must not be parallel to the view direction"));
+    }
+    if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
+        return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {}", c.fov_deg)));
+    }
+    let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height);
+    Ok(Scene::new(objects, materials, lights, camera, settings, content_hash))
+}
+
+/// Combines defaults, the file's `render` block and the command line.
+fn settings(ctx: &Ctx<'_>, file: &RenderDesc, cli: &RenderDesc) -> Result<Settings> {
+    let d = Settings::default();
+    let s = Settings {
+        width: cli.width.or(file.width).unwrap_or(d.width),
+        height: cli.height.or(file.height).unwrap_or(d.height),
+        spp: cli.spp.or(file.spp).unwrap_or(d.spp),
+        seed: cli.seed.or(file.seed).unwrap_or(d.seed),
+        max_bounces: cli.max_bounces.or(file.max_bounces).unwrap_or(d.max_bounces),
+        integrator: cli.integrator.or(file.integrator).unwrap_or(d.integrator),
+        wavelengths: cli.wavelengths.or(file.wavelengths).unwrap_or(d.wavelengths),
+        packet_size: cli.packet_size.or(file.packet_size).unwrap_or(d.packet_size),
+    };
+    for (name, v) in [("width", s.width), ("height", s.height), ("spp", s.spp)] {
+        if v == 0 {
+            return Err(ctx.err(format!("render.{name}"), "expected a positive number, found 0"));
+        }
+    }
+    if s.width > 1 << 15 || s.height > 1 << 15 {
+        return Err(ctx.err("render.width", "expected at most 32768 pixels per side"));
+    }
+    if ![1, 2, 4, 8].contains(&s.packet_size) {
+        return Err(ctx.err("render.packet_size", format!("expected 1, 2, 4 or 8, found {}", s.packet_size)));
+    }
+    Ok(s)
+}

@@ -1,0 +1,217 @@
+//! The scene: objects, materials, lights and camera, ready to render.
+//!
+//! Data flow: the RON file ([`desc`]) is parsed and checked by [`load`] into a
+//! [`Scene`]; the renderer asks it for the closest hit along a ray
+//! ([`Scene::intersect`]) and whether a shadow ray is blocked
+//! ([`Scene::occluded`]). Bounded objects sit in a BVH over their bounds
+//! when there are enough of them to pay for it; unbounded ones (planes) are
+//! tested one by one.
+
+pub mod desc;
+mod load;
+
+pub use load::{load_scene, load_scene_str};
+
+use crate::bvh::Bvh;
+use crate::bxdf::Bxdf;
+use crate::camera::Camera;
+use crate::geometry::{Hit, Ray, Shape};
+use crate::light::Light;
+use desc::{IntegratorKind, WavelengthsKind};
+
+/// Below this many bounded objects the scene tests them one by one instead of
+/// building a BVH over them: a handful of spheres and quads is faster to test
+/// directly than to traverse (see benches/render.rs).
+pub const BVH_MIN_OBJECTS: usize = 8;
+
+/// An object: a shape with a material and possibly an emission.
+#[derive(Debug)]
+pub struct Object {
+    /// The shape.
+    pub shape: Shape,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Index into [`Scene::lights`] when the object emits.
+    pub light: Option<u32>,
+}
+
+/// Render settings after the scene file and the command line are combined.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel (= passes).
+    pub spp: u32,
+    /// Seed of the deterministic sampler.
+    pub seed: u64,
+    /// Maximum number of scattering events on a path.
+    pub max_bounces: u32,
+    /// The integrator.
+    pub integrator: IntegratorKind,
+    /// Wavelength sampling (spectral integrator).
+    pub wavelengths: WavelengthsKind,
+    /// Wavelengths per packet (spectral integrator).
+    pub packet_size: u32,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            width: 512,
+            height: 512,
+            spp: 64,
+            seed: 0,
+            max_bounces: 8,
+            integrator: IntegratorKind::Path,
+            wavelengths: WavelengthsKind::Hero,
+            packet_size: 4,
+        }
+    }
+}
+
+/// The closest hit of a ray in the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    /// Geometry of the hit.
+    pub hit: Hit,
+    /// Index of the object hit.
+    pub object: u32,
+}
+
+/// Everything needed to render.
+#[derive(Debug)]
+pub struct Scene {
+    /// Objects.
+    pub objects: Vec<Object>,
+    /// Materials (objects refer to them by index).
+    pub materials: Vec<Bxdf>,
+    /// Lights (area lights refer back to their object).
+    pub lights: Vec<Light>,
+    /// Probability of choosing each light for next-event estimation (∝ power).
+    pub light_pmf: Vec<f32>,
+    light_cdf: Vec<f32>,
+    /// The camera.
+    pub camera: Camera,
+    /// Render settings from the file (before command-line overrides).
+    pub settings: Settings,
+    /// Indices of bounded objects, in the BVH's order when there is one.
+    bounded: Vec<u32>,
+    /// Indices of unbounded objects (planes).
+    unbounded: Vec<u32>,
+    bvh: Option<Bvh>,
+    /// A hash of the scene file's content (for checkpoints).
+    pub content_hash: u64,
+}
+
+impl Scene {
+    /// Builds the acceleration structure and light tables. `objects` and
+    /// `lights` must already be consistent (the loader ensures it).
+    pub fn new(
+        objects: Vec<Object>,
+        materials: Vec<Bxdf>,
+        lights: Vec<Light>,
+        camera: Camera,
+        settings: Settings,
+        content_hash: u64,
+    ) -> Scene {
+        let mut bounded = Vec::new();
+        let mut bounds = Vec::new();
+        let mut unbounded = Vec::new();
+        for (i, o) in objects.iter().enumerate() {
+            match o.shape.bounds() {
+                Some(b) => {
+                    bounded.push(i as u32);
+                    bounds.push(b);
+                }
+                None => unbounded.push(i as u32),
+            }
+        }
+        let bvh = (bounded.len() >= BVH_MIN_OBJECTS).then(|| {
+            let bvh = Bvh::build(&bounds);
+            bounded = bvh.prim_order().iter().map(|&k| bounded[k as usize]).collect();
+            bvh
+        });
+        let power: Vec<f32> = lights.iter().map(|l| l.power().max(0.0)).collect();
+        let total: f32 = power.iter().sum();
+        let light_pmf: Vec<f32> = if total > 0.0 {
+            power.iter().map(|p| p / total).collect()
+        } else {
+            vec![1.0 / lights.len().max(1) as f32; lights.len()]
+        };
+        let mut acc = 0.0;
+        let light_cdf = light_pmf
+            .iter()
+            .map(|p| {
+                acc += p;
+                acc
+            })
+            .collect();
+        Scene { objects, materials, lights, light_pmf, light_cdf, camera, settings, bounded, unbounded, bvh, content_hash }
+    }
+
+    /// The closest hit along `ray` before `t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        let mut best: Option<SurfaceHit> = None;
+        let mut t_max = t_max;
+        for &i in &self.unbounded {
+            if let Some(hit) = self.objects[i as usize].shape.intersect(ray, t_max) {
+                t_max = hit.t;
+                best = Some(SurfaceHit { hit, object: i });
+            }
+        }
+        match &self.bvh {
+            Some(bvh) => {
+                let found = bvh.intersect(ray, t_max, |k, t| {
+                    let object = self.bounded[k as usize];
+                    self.objects[object as usize].shape.intersect(ray, t).map(|hit| (hit.t, SurfaceHit { hit, object }))
+                });
+                found.or(best)
+            }
+            None => {
+                for &i in &self.bounded {
+                    if let Some(hit) = self.objects[i as usize].shape.intersect(ray, t_max) {
+                        t_max = hit.t;
+                        best = Some(SurfaceHit { hit, object: i });
+                    }
+                }
+                best
+            }
+        }
+    }
+
+    /// True when something blocks `ray` before `t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.unbounded.iter().any(|&i| self.objects[i as usize].shape.occluded(ray, t_max)) {
+            return true;
+        }
+        match &self.bvh {
+            Some(bvh) => bvh.occluded(ray, t_max, |k, t| self.objects[self.bounded[k as usize] as usize].shape.occluded(ray, t)),
+            None => self.bounded.iter().any(|&i| self.objects[i as usize].shape.occluded(ray, t_max)),
+        }
+    }
+
+    /// Chooses a light for next-event estimation with probability ∝ power;
+    /// returns its index and probability.
+    #[inline]
+    pub fn choose_light(&self, u: f32) -> Option<(usize, f32)> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let i = self.light_cdf.partition_point(|&c| c <= u).min(self.lights.len() - 1);
+        Some((i, self.light_pmf[i]))
+    }
+
+    /// True when any material's direction depends on wavelength.
+    pub fn has_dispersion(&self) -> bool {
+        self.objects.iter().any(|o| self.materials[o.material as usize].is_dispersive())
+    }
+
+    /// The number of objects.
+    pub fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+}

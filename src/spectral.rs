@@ -1,0 +1,352 @@
+//! Wavelength packets: which wavelengths a path carries, and the values it
+//! carries for them.
+//!
+//! Every integrator runs one generic path loop over a packet of `N`
+//! wavelengths ([`Lambdas<N>`]) whose per-wavelength values are a
+//! [`Sampled<N>`] (a fixed-size array the compiler vectorises):
+//!
+//! - `N = 36`, the identity packet: the full spectrum, every bin on every path
+//!   (the thesis's "path" tracer, and `auto` where nothing disperses);
+//! - `N = 4` (or 8): a hero packet (one bin uniform over the 36, the others at
+//!   equal rotation, thesis eq. 2.7) or independent random bins;
+//! - `N = 1`: one wavelength, after a packet split at a dispersive surface;
+//! - `N = 3`, the RGB mode: the three wavelengths 435.8, 546.1 and 700 nm of
+//!   the thesis's RGB renderer (Figure 5.8c), whose values are read as linear
+//!   sRGB blue, green and red.
+//!
+//! A packet stores fractional bin positions (`0.0` = 380 nm, `35.0` = 730 nm):
+//! spectra are sampled at integer positions exactly and linearly interpolated
+//! between bins (only the RGB mode uses non-integer positions).
+//!
+//! # Unbiasedness
+//! The pixel value is `XYZ = Σ_b L(b) · cmf(b)` over the 36 bins (see
+//! [`crate::color::cie`]). A packet that includes bin `b` with probability
+//! `P(b)` contributes `L(b) · cmf(b) / P(b)` for each of its bins, so every
+//! bin's expected contribution is exactly its share of the sum, at any sample
+//! count. Hero and random packets of `C` bins have `P(b) = C / 36` (hero: the
+//! rotation puts each bin in the packet for exactly `C` of the 36 hero
+//! choices; random: each of the `C` independent draws hits `b` with
+//! probability 1/36, counted with multiplicity). Those weights live in
+//! [`Lambdas::weight`], never in per-bin sample counters.
+
+use std::ops::{Add, AddAssign, Div, Index, Mul, MulAssign};
+
+use crate::color::{self, N_BINS, Spectrum, Xyz};
+
+/// The wavelengths of the RGB mode (thesis §5.2): blue, green, red in nm.
+pub const RGB_LAMBDAS_NM: [f32; 3] = [435.8, 546.1, 700.0];
+
+/// The reference wavelength that every wavelength follows at a dispersive
+/// interface in the non-spectral `path` integrator: the sodium D line.
+pub const REFERENCE_LAMBDA_NM: f32 = 589.3;
+
+/// Per-wavelength values of a packet of `N` wavelengths.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampled<const N: usize>(pub [f32; N]);
+
+impl<const N: usize> Sampled<N> {
+    /// Every value equal to `v`.
+    #[inline]
+    pub const fn splat(v: f32) -> Self {
+        Sampled([v; N])
+    }
+
+    /// The largest value.
+    #[inline]
+    pub fn max_value(&self) -> f32 {
+        self.0.iter().copied().fold(f32::NEG_INFINITY, f32::max)
+    }
+
+    /// True when every value is zero.
+    #[inline]
+    pub fn is_black(&self) -> bool {
+        self.0.iter().all(|&v| v == 0.0)
+    }
+
+    /// True when any value is NaN or infinite.
+    #[inline]
+    pub fn has_nan_or_inf(&self) -> bool {
+        self.0.iter().any(|v| !v.is_finite())
+    }
+}
+
+impl<const N: usize> Index<usize> for Sampled<N> {
+    type Output = f32;
+    #[inline]
+    fn index(&self, i: usize) -> &f32 {
+        &self.0[i]
+    }
+}
+
+impl<const N: usize> Add for Sampled<N> {
+    type Output = Self;
+    #[inline]
+    fn add(mut self, o: Self) -> Self {
+        self += o;
+        self
+    }
+}
+
+impl<const N: usize> AddAssign for Sampled<N> {
+    #[inline]
+    fn add_assign(&mut self, o: Self) {
+        for i in 0..N {
+            self.0[i] += o.0[i];
+        }
+    }
+}
+
+impl<const N: usize> Mul for Sampled<N> {
+    type Output = Self;
+    #[inline]
+    fn mul(mut self, o: Self) -> Self {
+        self *= o;
+        self
+    }
+}
+
+impl<const N: usize> MulAssign for Sampled<N> {
+    #[inline]
+    fn mul_assign(&mut self, o: Self) {
+        for i in 0..N {
+            self.0[i] *= o.0[i];
+        }
+    }
+}
+
+impl<const N: usize> Mul<f32> for Sampled<N> {
+    type Output = Self;
+    #[inline]
+    fn mul(mut self, s: f32) -> Self {
+        self *= s;
+        self
+    }
+}
+
+impl<const N: usize> MulAssign<f32> for Sampled<N> {
+    #[inline]
+    fn mul_assign(&mut self, s: f32) {
+        for v in &mut self.0 {
+            *v *= s;
+        }
+    }
+}
+
+impl<const N: usize> Div<f32> for Sampled<N> {
+    type Output = Self;
+    #[inline]
+    fn div(self, s: f32) -> Self {
+        self * (1.0 / s)
+    }
+}
+
+/// How a packet's values become a colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Readout {
+    /// Values are spectral radiance at the packet's bins: XYZ through the CMFs.
+    Spectral,
+    /// Values are linear sRGB (blue, green, red), the RGB mode.
+    Rgb,
+}
+
+/// A packet of `N` wavelengths, as fractional bin positions, with the
+/// weight `1 / P(bin in packet)` that keeps every bin's estimate unbiased.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambdas<const N: usize> {
+    /// Fractional bin positions: `0.0` is 380 nm, `35.0` is 730 nm.
+    pub pos: [f32; N],
+    /// The weight of each wavelength's contribution (`36 / C` for a packet
+    /// of `C` bins drawn as hero or random; 1 for the full spectrum).
+    pub weight: f32,
+    /// How values become colour.
+    pub readout: Readout,
+}
+
+impl<const N: usize> Lambdas<N> {
+    /// Wavelength `i` in nm.
+    #[inline]
+    pub fn lambda_nm(&self, i: usize) -> f32 {
+        color::LAMBDA_MIN_NM + color::LAMBDA_STEP_NM * self.pos[i]
+    }
+
+    /// A spectrum's values at the packet's wavelengths.
+    #[inline]
+    pub fn sample(&self, s: &Spectrum) -> Sampled<N> {
+        if N == N_BINS && self.readout == Readout::Spectral {
+            // The identity packet: a straight copy (positions are 0..36).
+            let mut out = [0.0; N];
+            out.copy_from_slice(&s.0[..N]);
+            return Sampled(out);
+        }
+        let mut out = [0.0; N];
+        for (o, &p) in out.iter_mut().zip(&self.pos) {
+            let i0 = (p as usize).min(N_BINS - 1);
+            let frac = p - i0 as f32;
+            *o = if frac <= 0.0 || i0 + 1 >= N_BINS {
+                s.0[i0]
+            } else {
+                s.0[i0] * (1.0 - frac) + s.0[i0 + 1] * frac
+            };
+        }
+        Sampled(out)
+    }
+
+    /// The single-wavelength packet of wavelength `i`, carrying this packet's weight.
+    #[inline]
+    pub fn single(&self, i: usize) -> Lambdas<1> {
+        Lambdas { pos: [self.pos[i]], weight: self.weight, readout: self.readout }
+    }
+
+    /// The colour of a packet of radiance values.
+    pub fn to_xyz(&self, l: &Sampled<N>) -> Xyz {
+        match self.readout {
+            Readout::Spectral => {
+                let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
+                for i in 0..N {
+                    // Packets of sampled bins always sit on integer positions.
+                    let w = color::cie::CMF_NORMALISED[self.pos[i] as usize];
+                    x += l.0[i] * w[0];
+                    y += l.0[i] * w[1];
+                    z += l.0[i] * w[2];
+                }
+                Xyz::new(x * self.weight, y * self.weight, z * self.weight)
+            }
+            Readout::Rgb => {
+                // Values are (b, g, r) in wavelength order; a single wavelength
+                // after a split is one channel carrying the packet weight 3.
+                let mut rgb = [0.0f32; 3];
+                for i in 0..N {
+                    let channel = rgb_channel(self.lambda_nm(i));
+                    rgb[channel] += l.0[i] * self.weight / 3.0;
+                }
+                color::LinearSrgb::new(rgb[0], rgb[1], rgb[2]).to_xyz()
+            }
+        }
+    }
+}
+
+/// Which linear sRGB channel (0 = r, 1 = g, 2 = b) an RGB-mode wavelength feeds.
+fn rgb_channel(lambda_nm: f32) -> usize {
+    if lambda_nm < 500.0 {
+        2
+    } else if lambda_nm < 650.0 {
+        1
+    } else {
+        0
+    }
+}
+
+impl Lambdas<N_BINS> {
+    /// The full spectrum: all 36 bins, weight 1.
+    pub fn full() -> Self {
+        Lambdas { pos: std::array::from_fn(|i| i as f32), weight: 1.0, readout: Readout::Spectral }
+    }
+}
+
+impl Lambdas<3> {
+    /// The RGB mode's three wavelengths (thesis §5.2), each carrying weight 3
+    /// so that a packet split into single wavelengths reads out the same.
+    pub fn rgb() -> Self {
+        let pos = RGB_LAMBDAS_NM.map(|l| (l - color::LAMBDA_MIN_NM) / color::LAMBDA_STEP_NM);
+        Lambdas { pos, weight: 3.0, readout: Readout::Rgb }
+    }
+}
+
+/// How a packet of `C` bins is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WavelengthSampling {
+    /// One bin uniform over the 36, the others at equal rotation (thesis eq. 2.7).
+    Hero,
+    /// `C` independent uniform bins.
+    Random,
+}
+
+/// Draws a packet of `C` bins. `u` supplies `C` uniform numbers in [0, 1)
+/// (hero uses only the first).
+pub fn sample_packet<const C: usize>(how: WavelengthSampling, u: [f32; C]) -> Lambdas<C> {
+    let bin = |x: f32| ((x * N_BINS as f32) as usize).min(N_BINS - 1);
+    let pos = match how {
+        WavelengthSampling::Hero => {
+            let h = bin(u[0]) as f32;
+            std::array::from_fn(|k| (h + (k * N_BINS) as f32 / C as f32).rem_euclid(N_BINS as f32).floor())
+        }
+        WavelengthSampling::Random => u.map(|x| bin(x) as f32),
+    };
+    Lambdas { pos, weight: N_BINS as f32 / C as f32, readout: Readout::Spectral }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every bin is in exactly C of the 36 hero packets, so P(b) = C/36 and
+    /// the weight 36/C is exact, for C = 4 (36/4 = 9 apart) and C = 8 (4.5
+    /// apart: rounded down, still a bijection per k).
+    #[test]
+    fn hero_packets_cover_every_bin_equally() {
+        fn check<const C: usize>() {
+            let mut count = [0usize; N_BINS];
+            for h in 0..N_BINS {
+                let u0 = (h as f32 + 0.5) / N_BINS as f32;
+                let mut u = [0.0; C];
+                u[0] = u0;
+                let l = sample_packet::<C>(WavelengthSampling::Hero, u);
+                assert_eq!(l.pos[0], h as f32);
+                for p in l.pos {
+                    count[p as usize] += 1;
+                }
+            }
+            assert!(count.iter().all(|&c| c == C), "C = {C}: {count:?}");
+        }
+        check::<4>();
+        check::<8>();
+        check::<1>();
+    }
+
+    #[test]
+    fn full_packet_reads_out_the_spectrum_xyz() {
+        let s = Spectrum::from_fn(|i| 0.1 + 0.02 * i as f32);
+        let l = Lambdas::full();
+        let a = l.to_xyz(&l.sample(&s));
+        let b = s.to_xyz();
+        assert!((a.x - b.x).abs() < 1e-5 && (a.y - b.y).abs() < 1e-5 && (a.z - b.z).abs() < 1e-5);
+    }
+
+    /// Averaging the readout over all 36 hero choices gives the full-spectrum
+    /// XYZ exactly: the packet estimator is unbiased by construction.
+    #[test]
+    fn hero_readout_is_unbiased_over_all_choices() {
+        let s = Spectrum::from_fn(|i| (i as f32 * 0.37).sin().abs() + 0.05);
+        let want = s.to_xyz();
+        let mut sum = [0.0f64; 3];
+        for h in 0..N_BINS {
+            let l = sample_packet::<4>(WavelengthSampling::Hero, [(h as f32 + 0.5) / 36.0, 0.0, 0.0, 0.0]);
+            let xyz = l.to_xyz(&l.sample(&s));
+            sum[0] += xyz.x as f64;
+            sum[1] += xyz.y as f64;
+            sum[2] += xyz.z as f64;
+        }
+        let got = sum.map(|v| v / N_BINS as f64);
+        assert!((got[0] - want.x as f64).abs() < 1e-5);
+        assert!((got[1] - want.y as f64).abs() < 1e-5);
+        assert!((got[2] - want.z as f64).abs() < 1e-5);
+    }
+
+    #[test]
+    fn rgb_packet_reads_values_as_linear_srgb() {
+        let l = Lambdas::rgb();
+        assert!((l.lambda_nm(0) - 435.8).abs() < 1e-3 && (l.lambda_nm(2) - 700.0).abs() < 1e-3);
+        // Values (b, g, r) = (0.25, 0.5, 1.0) read back as linear sRGB (1.0, 0.5, 0.25).
+        let xyz = l.to_xyz(&Sampled([0.25, 0.5, 1.0]));
+        let rgb = xyz.to_linear_srgb();
+        assert!((rgb.r - 1.0).abs() < 1e-4 && (rgb.g - 0.5).abs() < 1e-4 && (rgb.b - 0.25).abs() < 1e-4);
+        // Split into single wavelengths, the three read-outs add up to the same colour.
+        let mut sum = Xyz::default();
+        for (i, v) in [0.25, 0.5, 1.0].into_iter().enumerate() {
+            let one = l.single(i);
+            let x = one.to_xyz(&Sampled([v]));
+            sum = sum + x;
+        }
+        assert!((sum.x - xyz.x).abs() < 1e-4 && (sum.y - xyz.y).abs() < 1e-4 && (sum.z - xyz.z).abs() < 1e-4);
+    }
+}
