@@ -1,1 +1,648 @@
-//! BVH (stub).
+//! A bounding volume hierarchy over arbitrary primitives, given only their
+//! bounding boxes: binned-SAH build (parallel with rayon above a size threshold,
+//! deterministic whatever the thread count), flattened depth-first into 32-byte
+//! nodes (first child follows its parent, the second child's index is stored,
+//! pbrt's linear layout), and ordered stack traversal for closest and any hits.
+//!
+//! The BVH knows nothing of the primitives themselves: traversal calls back with
+//! the slot `k` of each primitive in a visited leaf. [`Bvh::prim_order`] maps slots
+//! to indices in the slice the tree was built from; meshes store their triangles
+//! in slot order so that leaves are contiguous in memory.
+
+// `!(x > 0.0)` is used on purpose: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::geometry::{Aabb, Ray, gamma};
+use glam::Vec3;
+
+/// Number of SAH bins per axis.
+const BINS: usize = 16;
+/// Largest leaf the SAH may choose.
+const MAX_LEAF: usize = 4;
+/// Node sizes above which the two children are built in parallel.
+const PARALLEL_THRESHOLD: usize = 64 * 1024;
+/// Traversal stack depth; the build keeps the tree shallower than this.
+const STACK: usize = 64;
+/// SAH cost of visiting a node, relative to intersecting one primitive.
+const TRAVERSAL_COST: f32 = 1.0;
+
+/// A flattened node: 32 bytes. Interior nodes have `count == 0`, their first child at
+/// the next index and their second at `offset`; leaves hold slots `offset..offset+count`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+struct Node {
+    min: Vec3,
+    max: Vec3,
+    offset: u32,
+    count: u16,
+    axis: u8,
+    _pad: u8,
+}
+
+/// A primitive during the build: its box and its index in the input slice.
+#[derive(Clone, Copy, Debug)]
+struct BuildPrim {
+    bounds: Aabb,
+    index: u32,
+}
+
+impl BuildPrim {
+    #[inline]
+    fn centroid(&self) -> Vec3 {
+        self.bounds.centroid()
+    }
+}
+
+/// A bounding volume hierarchy over primitive bounding boxes.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+}
+
+/// Per-ray data for the slab test.
+struct RayBox {
+    o: Vec3,
+    inv: Vec3,
+    neg: [bool; 3],
+}
+
+/// Factor applied to the far slab distances so that rounding never makes a ray miss a
+/// box that it grazes or a primitive lying exactly on a box face (pbrt's 1 + 2 gamma(3)).
+const ROBUST: f32 = 1.0 + 2.0 * gamma(3);
+
+impl RayBox {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayBox {
+        // 1/0 = +inf and 1/-0 = -inf: the slab of a zero direction component is then
+        // (-inf, inf) or empty, except when the origin lies exactly on a slab plane where
+        // 0 * inf = NaN, which the comparisons below ignore (the ray counts as inside).
+        let inv = Vec3::ONE / ray.dir;
+        RayBox {
+            o: ray.origin,
+            inv,
+            neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
+        }
+    }
+
+    /// True if the ray enters the node's box with `t < t_max` (and exits at `t >= 0`).
+    #[inline(always)]
+    fn hits(&self, n: &Node, t_max: f32) -> bool {
+        let (nx, fx) = if self.neg[0] {
+            (n.max.x, n.min.x)
+        } else {
+            (n.min.x, n.max.x)
+        };
+        let (ny, fy) = if self.neg[1] {
+            (n.max.y, n.min.y)
+        } else {
+            (n.min.y, n.max.y)
+        };
+        let (nz, fz) = if self.neg[2] {
+            (n.max.z, n.min.z)
+        } else {
+            (n.min.z, n.max.z)
+        };
+        let mut t0 = 0.0f32;
+        let mut t1 = t_max;
+        let a = (nx - self.o.x) * self.inv.x;
+        let b = (fx - self.o.x) * self.inv.x * ROBUST;
+        // Written so that a NaN slab value leaves t0/t1 unchanged.
+        t0 = if a > t0 { a } else { t0 };
+        t1 = if b < t1 { b } else { t1 };
+        let a = (ny - self.o.y) * self.inv.y;
+        let b = (fy - self.o.y) * self.inv.y * ROBUST;
+        t0 = if a > t0 { a } else { t0 };
+        t1 = if b < t1 { b } else { t1 };
+        let a = (nz - self.o.z) * self.inv.z;
+        let b = (fz - self.o.z) * self.inv.z * ROBUST;
+        t0 = if a > t0 { a } else { t0 };
+        t1 = if b < t1 { b } else { t1 };
+        t0 <= t1
+    }
+}
+
+impl Bvh {
+    /// Builds over primitive bounding boxes (binned SAH with 16 bins per axis on the
+    /// centroid bounds, all three axes tried; leaves of at most 4 primitives when the
+    /// SAH prefers them; children built in parallel with `rayon::join` above 64k
+    /// primitives). Deterministic: the same tree whatever the thread count.
+    pub fn build(prim_bounds: &[Aabb]) -> Bvh {
+        Self::build_with_threshold(prim_bounds, PARALLEL_THRESHOLD)
+    }
+
+    fn build_with_threshold(prim_bounds: &[Aabb], threshold: usize) -> Bvh {
+        let mut prims: Vec<BuildPrim> = prim_bounds
+            .iter()
+            .enumerate()
+            .map(|(i, b)| BuildPrim {
+                bounds: *b,
+                index: i as u32,
+            })
+            .collect();
+        let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
+        if !prims.is_empty() {
+            build_node(&mut prims, 0, 0, &mut nodes, threshold);
+        }
+        nodes.shrink_to_fit();
+        Bvh {
+            nodes,
+            order: prims.iter().map(|p| p.index).collect(),
+        }
+    }
+
+    /// Primitive order of the leaves: leaf ranges index into this; `prim_order()[k]` is an
+    /// index into the original slice. Meshes use it to reorder their triangles so that
+    /// leaves are contiguous.
+    pub fn prim_order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// Bounds of everything (empty for an empty tree).
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, |n| Aabb {
+            min: n.min,
+            max: n.max,
+        })
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Bytes used by the nodes and the primitive order.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<Node>() + self.order.len() * 4
+    }
+
+    /// SAH cost of the tree (traversal cost 1, intersection cost 1 per primitive,
+    /// areas normalised by the root's), for reports.
+    pub fn sah_cost(&self) -> f32 {
+        let Some(root) = self.nodes.first() else {
+            return 0.0;
+        };
+        let area = |n: &Node| {
+            Aabb {
+                min: n.min,
+                max: n.max,
+            }
+            .surface_area() as f64
+        };
+        let root_area = area(root);
+        if !(root_area > 0.0) {
+            return 0.0;
+        }
+        let cost: f64 = self
+            .nodes
+            .iter()
+            .map(|n| {
+                if n.count == 0 {
+                    area(n) * TRAVERSAL_COST as f64
+                } else {
+                    area(n) * n.count as f64
+                }
+            })
+            .sum();
+        (cost / root_area) as f32
+    }
+
+    /// Closest-hit traversal: visits leaves front to back (by the split axis and the
+    /// ray direction's sign), calls `hit(k, t_max)` for each primitive slot `k` in a
+    /// visited leaf (`k` indexes [`Bvh::prim_order`], i.e. the reordered position),
+    /// which returns `Some((t, payload))` on a hit closer than `t_max`; shrinks `t_max`;
+    /// returns the closest payload.
+    #[inline]
+    pub fn intersect<H>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut hit: impl FnMut(u32, f32) -> Option<(f32, H)>,
+    ) -> Option<H> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let rb = RayBox::new(ray);
+        let mut t_max = t_max;
+        let mut best = None;
+        let mut stack = [0u32; STACK];
+        let mut sp = 0usize;
+        let mut idx = 0usize;
+        loop {
+            let node = &self.nodes[idx];
+            if rb.hits(node, t_max) {
+                if node.count > 0 {
+                    let start = node.offset;
+                    for k in start..start + node.count as u32 {
+                        if let Some((t, h)) = hit(k, t_max) {
+                            if t < t_max {
+                                t_max = t;
+                                best = Some(h);
+                            }
+                        }
+                    }
+                } else {
+                    // Visit the child on the near side of the split first.
+                    let (first, second) = if rb.neg[node.axis as usize] {
+                        (node.offset as usize, idx + 1)
+                    } else {
+                        (idx + 1, node.offset as usize)
+                    };
+                    stack[sp] = second as u32;
+                    sp += 1;
+                    idx = first;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            idx = stack[sp] as usize;
+        }
+        best
+    }
+
+    /// Any-hit traversal; `hit(k, t_max)` returns true if primitive slot `k` blocks the
+    /// ray before `t_max`. Stops at the first blocker.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32, mut hit: impl FnMut(u32, f32) -> bool) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let rb = RayBox::new(ray);
+        let mut stack = [0u32; STACK];
+        let mut sp = 0usize;
+        let mut idx = 0usize;
+        loop {
+            let node = &self.nodes[idx];
+            if rb.hits(node, t_max) {
+                if node.count > 0 {
+                    let start = node.offset;
+                    for k in start..start + node.count as u32 {
+                        if hit(k, t_max) {
+                            return true;
+                        }
+                    }
+                } else {
+                    let (first, second) = if rb.neg[node.axis as usize] {
+                        (node.offset as usize, idx + 1)
+                    } else {
+                        (idx + 1, node.offset as usize)
+                    };
+                    stack[sp] = second as u32;
+                    sp += 1;
+                    idx = first;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            idx = stack[sp] as usize;
+        }
+    }
+}
+
+/// Smallest `k` with `2^k >= n`.
+fn ceil_log2(n: usize) -> u32 {
+    usize::BITS - n.saturating_sub(1).leading_zeros()
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: Aabb,
+    count: u32,
+}
+
+/// Bin of centroid coordinate `c` (same formula for binning and partitioning).
+#[inline(always)]
+fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
+    (((c - lo) * scale) as usize).min(BINS - 1)
+}
+
+/// Builds the subtree over `prims` (slots `first..first + prims.len()`), appending its
+/// nodes depth-first to `nodes`; node offsets are relative to the start of `nodes`.
+fn build_node(
+    prims: &mut [BuildPrim],
+    first: u32,
+    depth: u32,
+    nodes: &mut Vec<Node>,
+    threshold: usize,
+) {
+    let n = prims.len();
+    let mut bounds = Aabb::EMPTY;
+    let mut cb = Aabb::EMPTY;
+    for p in prims.iter() {
+        bounds = bounds.union(&p.bounds);
+        cb = cb.grow(p.centroid());
+    }
+    let me = nodes.len();
+    nodes.push(Node {
+        min: bounds.min,
+        max: bounds.max,
+        offset: first,
+        count: n as u16,
+        axis: 0,
+        _pad: 0,
+    });
+    if n == 1 {
+        return;
+    }
+
+    let extent = cb.diagonal();
+    // Too deep for the traversal stack if SAH keeps peeling: fall back to median splits,
+    // which finish in ceil(log2 n) more levels.
+    let force_median = depth + ceil_log2(n) + 2 >= STACK as u32;
+    let mut split: Option<(usize, usize)> = None; // (axis, last bin on the left)
+    if !force_median {
+        let mut bins = [[Bin {
+            bounds: Aabb::EMPTY,
+            count: 0,
+        }; BINS]; 3];
+        let mut scale = [0.0f32; 3];
+        for a in 0..3 {
+            if extent[a] > 0.0 {
+                scale[a] = BINS as f32 / extent[a];
+            }
+        }
+        for p in prims.iter() {
+            let c = p.centroid();
+            for a in 0..3 {
+                let b = &mut bins[a][bin_of(c[a], cb.min[a], scale[a])];
+                b.count += 1;
+                b.bounds = b.bounds.union(&p.bounds);
+            }
+        }
+        let mut best_cost = f32::INFINITY;
+        for a in 0..3 {
+            if !(extent[a] > 0.0) {
+                continue;
+            }
+            // Right-to-left sweep: area * count of the right part for each split.
+            let mut right = [0.0f32; BINS];
+            let mut rb = Aabb::EMPTY;
+            let mut rc = 0u32;
+            for i in (1..BINS).rev() {
+                rb = rb.union(&bins[a][i].bounds);
+                rc += bins[a][i].count;
+                right[i - 1] = rb.surface_area() * rc as f32;
+            }
+            let mut lb = Aabb::EMPTY;
+            let mut lc = 0u32;
+            for i in 0..BINS - 1 {
+                lb = lb.union(&bins[a][i].bounds);
+                lc += bins[a][i].count;
+                if lc == 0 || lc as usize == n {
+                    continue;
+                }
+                let cost = lb.surface_area() * lc as f32 + right[i];
+                if cost < best_cost {
+                    best_cost = cost;
+                    split = Some((a, i));
+                }
+            }
+        }
+        let area = bounds.surface_area();
+        let split_cost = if area > 0.0 {
+            TRAVERSAL_COST + best_cost / area
+        } else {
+            f32::INFINITY
+        };
+        if n <= MAX_LEAF && (n as f32) <= split_cost {
+            return;
+        }
+        if split.is_none() && n <= MAX_LEAF {
+            return;
+        }
+    } else if n <= MAX_LEAF {
+        return;
+    }
+
+    let (mid, axis) = match split {
+        Some((a, last)) => {
+            let (lo, scale) = (cb.min[a], BINS as f32 / extent[a]);
+            let mid = partition(prims, |p| bin_of(p.centroid()[a], lo, scale) <= last);
+            (mid, a)
+        }
+        None => {
+            // Median split on the widest centroid axis, ties broken by index.
+            let a = if extent.x >= extent.y && extent.x >= extent.z {
+                0
+            } else if extent.y >= extent.z {
+                1
+            } else {
+                2
+            };
+            let mid = n / 2;
+            prims.select_nth_unstable_by(mid, |p, q| {
+                p.centroid()[a]
+                    .total_cmp(&q.centroid()[a])
+                    .then(p.index.cmp(&q.index))
+            });
+            (mid, a)
+        }
+    };
+    let (left, right) = prims.split_at_mut(mid);
+    let second = if n > threshold {
+        let (ln, rn) = rayon::join(
+            || {
+                let mut v = Vec::new();
+                build_node(left, first, depth + 1, &mut v, threshold);
+                v
+            },
+            || {
+                let mut v = Vec::new();
+                build_node(right, first + mid as u32, depth + 1, &mut v, threshold);
+                v
+            },
+        );
+        append(nodes, ln);
+        let second = nodes.len();
+        append(nodes, rn);
+        second
+    } else {
+        build_node(left, first, depth + 1, nodes, threshold);
+        let second = nodes.len();
+        build_node(right, first + mid as u32, depth + 1, nodes, threshold);
+        second
+    };
+    let node = &mut nodes[me];
+    node.offset = second as u32;
+    node.count = 0;
+    node.axis = axis as u8;
+}
+
+/// Appends a subtree built in its own vector, shifting its interior links.
+fn append(nodes: &mut Vec<Node>, sub: Vec<Node>) {
+    let base = nodes.len() as u32;
+    nodes.extend(sub.into_iter().map(|mut n| {
+        if n.count == 0 {
+            n.offset += base;
+        }
+        n
+    }));
+}
+
+/// Stable-in-outcome, in-place two-way partition; returns the number of elements for
+/// which `left` holds (they come first).
+fn partition(prims: &mut [BuildPrim], left: impl Fn(&BuildPrim) -> bool) -> usize {
+    let mut i = 0;
+    let mut j = prims.len();
+    loop {
+        while i < j && left(&prims[i]) {
+            i += 1;
+        }
+        while i < j && !left(&prims[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            return i;
+        }
+        prims.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Triangle;
+    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use rand_pcg::Pcg32;
+
+    fn soup(n: usize, seed: u64) -> Vec<Triangle> {
+        let mut rng = Pcg32::new(seed, 1);
+        let mut v = || Vec3::new(uniform(&mut rng), uniform(&mut rng), uniform(&mut rng));
+        (0..n)
+            .map(|_| {
+                let c = v() * 10.0 - 5.0;
+                let s = 0.1 + uniform_len(&mut v);
+                Triangle::new(
+                    c + (v() - 0.5) * s,
+                    c + (v() - 0.5) * s,
+                    c + (v() - 0.5) * s,
+                )
+            })
+            .collect()
+    }
+
+    fn uniform_len(v: &mut impl FnMut() -> Vec3) -> f32 {
+        v().x * 2.0
+    }
+
+    #[test]
+    fn node_is_32_bytes() {
+        assert_eq!(std::mem::size_of::<Node>(), 32);
+    }
+
+    #[test]
+    fn matches_brute_force_on_triangle_soup() {
+        let tris = soup(3000, 1);
+        let bvh = Bvh::build(&tris.iter().map(|t| t.bounds()).collect::<Vec<_>>());
+        assert!(bvh.sah_cost() > 1.0);
+        let mut order = bvh.prim_order().to_vec();
+        order.sort();
+        assert!(
+            order.iter().enumerate().all(|(i, &k)| i as u32 == k),
+            "prim_order is a permutation"
+        );
+        let mut rng = Pcg32::new(2, 2);
+        let mut hits = 0;
+        for i in 0..10_000 {
+            let o = Vec3::new(uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)) * 14.0 - 7.0;
+            let mut d = random_dir(&mut rng);
+            if i % 10 == 0 {
+                // Axis-parallel rays, including -0 components.
+                d = [Vec3::X, -Vec3::Y, Vec3::new(-0.0, 0.0, 1.0)][i / 10 % 3];
+            }
+            let ray = Ray::new(o, d);
+            let t_max = if i % 7 == 0 { 3.0 } else { f32::INFINITY };
+            let brute = tris
+                .iter()
+                .enumerate()
+                .filter_map(|(k, t)| t.intersect(&ray, t_max).map(|h| (h.t, k as u32)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let got = bvh.intersect(&ray, t_max, |k, tm| {
+                let idx = bvh.prim_order()[k as usize];
+                tris[idx as usize]
+                    .intersect(&ray, tm)
+                    .map(|h| (h.t, (h.t, idx)))
+            });
+            match (brute, got) {
+                (None, None) => {}
+                (Some((tb, kb)), Some((tg, kg))) => {
+                    hits += 1;
+                    assert!((tb - tg).abs() <= 1e-5 * tb, "ray {i}: t {tb} vs {tg}");
+                    assert!(kb == kg || tb == tg, "ray {i}: triangle {kb} vs {kg}");
+                }
+                other => panic!("ray {i}: brute force {:?} vs bvh {:?}", other.0, other.1),
+            }
+            let occ = bvh.occluded(&ray, t_max, |k, tm| {
+                tris[bvh.prim_order()[k as usize] as usize].occluded(&ray, tm)
+            });
+            assert_eq!(occ, brute.is_some(), "ray {i}: occluded");
+        }
+        assert!(hits > 2000, "test rays should hit often ({hits})");
+    }
+
+    #[test]
+    fn deterministic_across_thread_counts() {
+        let tris = soup(5000, 3);
+        let b: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
+        let reference = Bvh::build_with_threshold(&b, 64);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let t = pool.install(|| Bvh::build_with_threshold(&b, 64));
+            assert_eq!(t.nodes, reference.nodes, "{threads} threads");
+            assert_eq!(t.order, reference.order);
+        }
+        let serial = Bvh::build_with_threshold(&b, usize::MAX);
+        assert_eq!(serial.nodes, reference.nodes);
+        assert_eq!(Bvh::build(&b).nodes, reference.nodes);
+    }
+
+    #[test]
+    fn empty_identical_and_flat_inputs() {
+        let empty = Bvh::build(&[]);
+        assert_eq!(empty.node_count(), 0);
+        assert!(
+            empty
+                .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY, |_, _| Some(
+                    (1.0, ())
+                ))
+                .is_none()
+        );
+        // Many identical boxes: median splits, bounded depth, all reachable.
+        let same = vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 1000];
+        let bvh = Bvh::build(&same);
+        let mut seen = 0;
+        bvh.occluded(
+            &Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z),
+            f32::INFINITY,
+            |_, _| {
+                seen += 1;
+                false
+            },
+        );
+        assert_eq!(seen, 1000);
+        // A box flat in z, hit by a ray lying in its plane and by a ray with zero components.
+        let flat = [Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))];
+        let bvh = Bvh::build(&flat);
+        let hit = |r: Ray| bvh.occluded(&r, f32::INFINITY, |_, _| true);
+        assert!(hit(Ray::new(Vec3::new(-1.0, 0.5, 0.0), Vec3::X)));
+        assert!(hit(Ray::new(
+            Vec3::new(0.5, 0.5, 1.0),
+            Vec3::new(0.0, -0.0, -1.0)
+        )));
+        assert!(!hit(Ray::new(
+            Vec3::new(1.5, 0.5, 1.0),
+            Vec3::new(0.0, -0.0, -1.0)
+        )));
+    }
+}

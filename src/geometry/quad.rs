@@ -1,0 +1,142 @@
+//! Quads: parallelograms `origin + a * edge_u + b * edge_v`, `a, b` in [0, 1], with
+//! normal `normalize(edge_u x edge_v)` (the same on both sides). Typical area lights.
+
+use super::plane::plane_t;
+use super::{Aabb, Hit, Ray};
+use glam::Vec3;
+
+/// A parallelogram.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quad {
+    /// One corner.
+    pub origin: Vec3,
+    /// First edge from `origin`.
+    pub edge_u: Vec3,
+    /// Second edge from `origin`.
+    pub edge_v: Vec3,
+}
+
+impl Quad {
+    /// A quad from a corner and its two edges.
+    pub fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Quad {
+        Quad {
+            origin,
+            edge_u,
+            edge_v,
+        }
+    }
+
+    /// Unit normal `normalize(edge_u x edge_v)`.
+    #[inline]
+    pub fn normal(&self) -> Vec3 {
+        self.edge_u.cross(self.edge_v).normalize_or_zero()
+    }
+
+    /// Area `|edge_u x edge_v|`.
+    pub fn area(&self) -> f32 {
+        self.edge_u.cross(self.edge_v).length()
+    }
+
+    /// Ray parameter and the quad coordinates `(a, b)` of the hit.
+    #[inline]
+    fn hit_coords(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32, Vec3)> {
+        let c = self.edge_u.cross(self.edge_v);
+        let len2 = c.length_squared();
+        if !(len2 > 0.0) {
+            return None;
+        }
+        let n = c / len2.sqrt();
+        let t = plane_t(n, n.dot(self.origin), ray, t_max)?;
+        let q = ray.at(t) - self.origin;
+        let w = c / len2;
+        let a = w.dot(q.cross(self.edge_v));
+        let b = w.dot(self.edge_u.cross(q));
+        ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, a, b, n))
+    }
+
+    /// Closest hit with `0 < t < t_max`; the point is rebuilt from the quad coordinates.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let (t, a, b, n) = self.hit_coords(ray, t_max)?;
+        Some(Hit::flat(
+            t,
+            self.origin + self.edge_u * a + self.edge_v * b,
+            n,
+        ))
+    }
+
+    /// True if the ray hits the quad with `0 < t < t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.hit_coords(ray, t_max).is_some()
+    }
+
+    /// Bounding box of the four corners.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.origin, self.origin + self.edge_u)
+            .grow(self.origin + self.edge_v)
+            .grow(self.origin + self.edge_u + self.edge_v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use rand_pcg::Pcg32;
+
+    #[test]
+    fn corners_in_and_out() {
+        let q = Quad::new(
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        assert_eq!(q.normal(), Vec3::Z);
+        let down = -Vec3::Z;
+        let h = q
+            .intersect(&Ray::new(Vec3::new(1.0, 0.5, 3.0), down), f32::INFINITY)
+            .unwrap();
+        assert!((h.t - 3.0).abs() < 1e-6 && h.n == Vec3::Z && h.p == Vec3::new(1.0, 0.5, 0.0));
+        assert!(q.occluded(&Ray::new(Vec3::new(1.999, 0.999, 3.0), down), f32::INFINITY));
+        assert!(q.occluded(&Ray::new(Vec3::new(0.001, 0.001, 3.0), down), f32::INFINITY));
+        assert!(!q.occluded(&Ray::new(Vec3::new(2.001, 0.999, 3.0), down), f32::INFINITY));
+        assert!(!q.occluded(&Ray::new(Vec3::new(1.0, -0.001, 3.0), down), f32::INFINITY));
+        // Skewed parallelogram: the point (0.2, 0.5) is outside, (1.2, 0.5) inside.
+        let s = Quad::new(Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0));
+        assert!(!s.occluded(&Ray::new(Vec3::new(0.2, 0.5, 1.0), down), f32::INFINITY));
+        assert!(s.occluded(&Ray::new(Vec3::new(1.2, 0.5, 1.0), down), f32::INFINITY));
+        let b = s.bounds();
+        assert_eq!((b.min, b.max), (Vec3::ZERO, Vec3::new(2.0, 1.0, 0.0)));
+    }
+
+    #[test]
+    fn spawned_rays_do_not_rehit_at_any_scale() {
+        let mut rng = Pcg32::new(11, 3);
+        for (scale, offset) in [
+            (1e-4f32, Vec3::ZERO),
+            (1.0, Vec3::ZERO),
+            (1e4, Vec3::ZERO),
+            (1.0, Vec3::new(1e4, 0.0, 0.0)),
+        ] {
+            let q = Quad::new(
+                offset + Vec3::new(-0.5, 0.2, -0.5) * scale,
+                Vec3::new(1.0, 0.3, 0.0) * scale,
+                Vec3::new(0.1, -0.2, 1.0) * scale,
+            );
+            let mut bad = 0;
+            for _ in 0..10_000 {
+                let target = q.origin + q.edge_u * uniform(&mut rng) + q.edge_v * uniform(&mut rng);
+                let o = target + random_dir(&mut rng) * 2.0 * scale;
+                let Some(h) = q.intersect(&Ray::new(o, (target - o).normalize()), f32::INFINITY)
+                else {
+                    continue;
+                };
+                if q.occluded(&Ray::spawn(h.p, h.n, random_dir(&mut rng)), f32::INFINITY) {
+                    bad += 1;
+                }
+            }
+            assert_eq!(bad, 0, "scale {scale} offset {offset}");
+        }
+    }
+}

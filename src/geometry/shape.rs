@@ -1,0 +1,98 @@
+//! The closed set of shapes a scene object can have, dispatched with `match`
+//! (no trait objects, no allocation on the per-ray path).
+
+use super::{Aabb, Bubble, Cuboid, Disk, Hit, Mesh, Plane, Quad, Ray, Sphere};
+
+/// Any shape of the renderer.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    /// A solid sphere.
+    Sphere(Sphere),
+    /// A spherical shell.
+    Bubble(Bubble),
+    /// An infinite plane (unbounded).
+    Plane(Plane),
+    /// A flat disk.
+    Disk(Disk),
+    /// A solid axis-aligned box.
+    Cuboid(Cuboid),
+    /// A parallelogram.
+    Quad(Quad),
+    /// A triangle mesh with its own BVH.
+    Mesh(Box<Mesh>),
+}
+
+impl Shape {
+    /// Closest hit with `0 < t < t_max`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        match self {
+            Shape::Sphere(s) => s.intersect(ray, t_max),
+            Shape::Bubble(s) => s.intersect(ray, t_max),
+            Shape::Plane(s) => s.intersect(ray, t_max),
+            Shape::Disk(s) => s.intersect(ray, t_max),
+            Shape::Cuboid(s) => s.intersect(ray, t_max),
+            Shape::Quad(s) => s.intersect(ray, t_max),
+            Shape::Mesh(s) => s.intersect(ray, t_max),
+        }
+    }
+
+    /// True if anything blocks the ray with `0 < t < t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        match self {
+            Shape::Sphere(s) => s.occluded(ray, t_max),
+            Shape::Bubble(s) => s.occluded(ray, t_max),
+            Shape::Plane(s) => s.occluded(ray, t_max),
+            Shape::Disk(s) => s.occluded(ray, t_max),
+            Shape::Cuboid(s) => s.occluded(ray, t_max),
+            Shape::Quad(s) => s.occluded(ray, t_max),
+            Shape::Mesh(s) => s.occluded(ray, t_max),
+        }
+    }
+
+    /// Bounding box; None for unbounded shapes (planes).
+    pub fn bounds(&self) -> Option<Aabb> {
+        match self {
+            Shape::Sphere(s) => Some(s.bounds()),
+            Shape::Bubble(s) => Some(s.bounds()),
+            Shape::Plane(_) => None,
+            Shape::Disk(s) => Some(s.bounds()),
+            Shape::Cuboid(s) => Some(s.bounds()),
+            Shape::Quad(s) => Some(s.bounds()),
+            Shape::Mesh(s) => Some(s.bounds()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn dispatch_agrees_with_shapes() {
+        let shapes = [
+            Shape::Sphere(Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0)),
+            Shape::Bubble(Bubble::new(Vec3::new(0.0, 0.0, 5.0), 1.0, 0.5)),
+            Shape::Plane(Plane::new(Vec3::new(0.0, 0.0, 4.0), Vec3::Z)),
+            Shape::Disk(Disk::new(Vec3::new(0.0, 0.0, 4.0), Vec3::Z, 1.0)),
+            Shape::Cuboid(Cuboid::new(
+                Vec3::new(-1.0, -1.0, 4.0),
+                Vec3::new(1.0, 1.0, 6.0),
+            )),
+            Shape::Quad(Quad::new(
+                Vec3::new(-1.0, -1.0, 4.0),
+                Vec3::X * 2.0,
+                Vec3::Y * 2.0,
+            )),
+        ];
+        let r = Ray::new(Vec3::ZERO, Vec3::Z);
+        for s in &shapes {
+            let h = s.intersect(&r, f32::INFINITY).unwrap();
+            assert!((h.t - 4.0).abs() < 1e-5 && (h.n.z.abs() - 1.0).abs() < 1e-6);
+            assert!(s.occluded(&r, 4.5) && !s.occluded(&r, 3.5));
+        }
+        assert!(shapes[2].bounds().is_none() && shapes[0].bounds().is_some());
+    }
+}
