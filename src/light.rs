@@ -2,9 +2,11 @@
 //!
 //! Area lights are scene objects with an `emission` (a sphere or a disk); they
 //! emit from their outer side only, like Mitsuba's `area` emitter, with
-//! radiance `L_e(λ)`. A sphere is sampled uniformly over the cone it subtends
-//! (pdf per solid angle `1 / (2π (1 − cos θmax))`, pbrt-v4 §6.2.4), a disk
-//! uniformly by area (pdf converted to solid angle: `d² / (|cos θ_l| A)`).
+//! radiance `L_e(λ)`, unless `two_sided: true` (pbrt-v4's `twosided`). A
+//! sphere seen from outside is sampled uniformly over the cone it subtends
+//! (pdf per solid angle `1 / (2π (1 − cos θmax))`, pbrt-v4 §6.2.4); from
+//! inside (two-sided only) and a disk always, uniformly by area (pdf converted
+//! to solid angle: `d² / (|cos θ_l| A)`).
 //! A point light has intensity `I(λ)` and is a delta light.
 //!
 //! ```ron
@@ -17,7 +19,7 @@ use std::f32::consts::PI;
 
 use crate::color::Spectrum;
 use crate::geometry::{Disk, Frame, Sphere};
-use crate::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf};
+use crate::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere};
 
 /// The closed set of lights.
 #[derive(Clone, Debug)]
@@ -29,19 +31,23 @@ pub enum Light {
         /// Radiant intensity per wavelength.
         intensity: Spectrum,
     },
-    /// A spherical area light emitting `radiance` outward.
+    /// A spherical area light emitting `radiance` outward (and inward too when two-sided).
     Sphere {
         /// Its shape.
         sphere: Sphere,
         /// Emitted radiance per wavelength.
         radiance: Spectrum,
+        /// Emits from both sides.
+        two_sided: bool,
     },
-    /// A one-sided disk light emitting `radiance` to the side its normal points to.
+    /// A disk light emitting `radiance` to the side its normal points to (both when two-sided).
     Disk {
         /// Its shape.
         disk: Disk,
         /// Emitted radiance per wavelength.
         radiance: Spectrum,
+        /// Emits from both sides.
+        two_sided: bool,
     },
 }
 
@@ -74,10 +80,11 @@ impl Light {
     /// choose among lights in proportion to power.
     pub fn power(&self) -> f32 {
         let mean = self.spectrum().average();
+        let sides = |two: bool| if two { 2.0 } else { 1.0 };
         match self {
             Light::Point { .. } => 4.0 * PI * mean,
-            Light::Sphere { sphere, .. } => PI * 4.0 * PI * sphere.radius * sphere.radius * mean,
-            Light::Disk { disk, .. } => PI * PI * disk.radius * disk.radius * mean,
+            Light::Sphere { sphere, two_sided, .. } => sides(*two_sided) * PI * 4.0 * PI * sphere.radius * sphere.radius * mean,
+            Light::Disk { disk, two_sided, .. } => sides(*two_sided) * PI * PI * disk.radius * disk.radius * mean,
         }
     }
 
@@ -93,13 +100,27 @@ impl Light {
                 }
                 Some(LightSample { wi: d / d2.sqrt(), point: *position, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
             }
-            Light::Sphere { sphere, .. } => {
+            Light::Sphere { sphere, two_sided, .. } => {
                 let to_c = sphere.center - p;
                 let d2 = to_c.length_squared();
                 let r2 = sphere.radius * sphere.radius;
                 if d2 <= r2 {
-                    // Inside a sphere that emits outward: nothing to see.
-                    return None;
+                    if !*two_sided {
+                        // Inside a sphere that emits outward: nothing to see.
+                        return None;
+                    }
+                    // Inside: uniform by area, converted to solid angle.
+                    let n = uniform_sphere(u);
+                    let point = sphere.center + n * sphere.radius;
+                    let d = point - p;
+                    let dist2 = d.length_squared();
+                    let wi = d / dist2.sqrt();
+                    let cos_l = wi.dot(n).abs();
+                    if cos_l == 0.0 {
+                        return None;
+                    }
+                    let pdf = dist2 / (cos_l * 4.0 * PI * r2);
+                    return Some(LightSample { wi, point, pdf, scale: 1.0, is_delta: false });
                 }
                 let d = d2.sqrt();
                 let sin2_max = r2 / d2;
@@ -114,7 +135,7 @@ impl Light {
                 let point = p + wi * dist;
                 Some(LightSample { wi, point, pdf: uniform_cone_pdf(cos_max), scale: 1.0, is_delta: false })
             }
-            Light::Disk { disk, .. } => {
+            Light::Disk { disk, two_sided, .. } => {
                 let frame = Frame::from_z(disk.normal);
                 let q = concentric_disk(u) * disk.radius;
                 let point = disk.center + frame.to_world(Vec3::new(q.x, q.y, 0.0));
@@ -124,7 +145,7 @@ impl Light {
                     return None;
                 }
                 let wi = d / d2.sqrt();
-                let cos_l = -wi.dot(disk.normal);
+                let cos_l = if *two_sided { wi.dot(disk.normal).abs() } else { -wi.dot(disk.normal) };
                 if cos_l <= 0.0 {
                     return None; // the back of a one-sided light
                 }
@@ -140,16 +161,21 @@ impl Light {
     pub fn pdf_li(&self, p: Vec3, wi: Vec3, point: Vec3) -> f32 {
         match self {
             Light::Point { .. } => 0.0,
-            Light::Sphere { sphere, .. } => {
+            Light::Sphere { sphere, two_sided, .. } => {
                 let d2 = (sphere.center - p).length_squared();
                 let r2 = sphere.radius * sphere.radius;
                 if d2 <= r2 {
-                    return 0.0;
+                    if !*two_sided {
+                        return 0.0;
+                    }
+                    let n = (point - sphere.center) / sphere.radius;
+                    let cos_l = wi.dot(n).abs();
+                    return (point - p).length_squared() / (cos_l * 4.0 * PI * r2);
                 }
                 uniform_cone_pdf((1.0 - r2 / d2).max(0.0).sqrt())
             }
-            Light::Disk { disk, .. } => {
-                let cos_l = -wi.dot(disk.normal);
+            Light::Disk { disk, two_sided, .. } => {
+                let cos_l = if *two_sided { wi.dot(disk.normal).abs() } else { -wi.dot(disk.normal) };
                 if cos_l <= 0.0 {
                     return 0.0;
                 }
@@ -165,8 +191,8 @@ impl Light {
     pub fn le_scale(&self, n: Vec3, dir: Vec3) -> f32 {
         match self {
             Light::Point { .. } => 0.0,
-            Light::Sphere { .. } | Light::Disk { .. } => {
-                if n.dot(dir) < 0.0 {
+            Light::Sphere { two_sided, .. } | Light::Disk { two_sided, .. } => {
+                if *two_sided || n.dot(dir) < 0.0 {
                     1.0
                 } else {
                     0.0
@@ -188,7 +214,7 @@ mod tests {
     /// Also every sampled direction hits the sphere at the returned point.
     #[test]
     fn sphere_light_pdf_integrates_to_one_and_samples_hit() {
-        let light = Light::Sphere { sphere: Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5), radiance: Spectrum::ONE };
+        let light = Light::Sphere { sphere: Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5), radiance: Spectrum::ONE, two_sided: false };
         let p = Vec3::new(0.3, 0.0, 0.1);
         let mut s = Sampler::new(1, 1, 1);
         let n = 200_000;
@@ -213,7 +239,7 @@ mod tests {
     #[test]
     fn disk_light_pdf_integrates_to_one() {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
-        let light = Light::Disk { disk: disk.clone(), radiance: Spectrum::ONE };
+        let light = Light::Disk { disk: disk.clone(), radiance: Spectrum::ONE, two_sided: false };
         let p = Vec3::new(0.5, 0.0, -0.2);
         let mut s = Sampler::new(2, 1, 1);
         let n = 200_000;

@@ -156,6 +156,7 @@ impl Shading {
         let geometric_same_side = wi.dot(self.n) * self.wo_n > 0.0;
         let shading_same_side = wi_local.z * self.wo.z > 0.0;
         geometric_same_side == shading_same_side
+    }
 }
 
 /// One next-event estimate at a non-delta surface: a light chosen by power, a

@@ -276,6 +276,10 @@ pub struct ObjectDesc {
     /// Emitted radiance, making the object an area light (spheres and disks).
     #[serde(default)]
     pub emission: Option<SpectrumDesc>,
+    /// Whether the emission leaves both sides of the surface (default false:
+    /// only the side the normal points to, outward for a sphere).
+    #[serde(default)]
+    pub two_sided: bool,
 }
 
 /// A light that is not an object.

@@ -193,7 +193,8 @@ impl Ctx<'_> {
                     translate: translate.map(Vec3::from).unwrap_or(Vec3::ZERO),
                 };
                 let file = self.dir.join(path);
-                Shape::Mesh(Box::new(Mesh::load(&file, &transform)?))
+                let mesh = Mesh::load(&file, &transform).map_err(|e| self.err(f("path"), e.to_string()))?;
+                Shape::Mesh(Box::new(mesh))
             }
         })
     }
@@ -228,8 +229,8 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &RenderDesc, content_hash: u
             Some(e) => {
                 let radiance = ctx.spectrum(&format!("{field}.emission"), e)?;
                 let l = match &shape {
-                    Shape::Sphere(s) => Light::Sphere { sphere: s.clone(), radiance },
-                    Shape::Disk(d) => Light::Disk { disk: d.clone(), radiance },
+                    Shape::Sphere(s) => Light::Sphere { sphere: s.clone(), radiance, two_sided: o.two_sided },
+                    Shape::Disk(d) => Light::Disk { disk: d.clone(), radiance, two_sided: o.two_sided },
                     _ => return Err(ctx.err(format!("{field}.emission"), "only Sphere and Disk shapes can emit")),
                 };
                 lights.push(l);

@@ -1,0 +1,56 @@
+//! Helpers shared by the integration tests.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::AtomicBool;
+
+use rust_v::film::Film;
+use rust_v::render::{Limits, render};
+use rust_v::scene::desc::RenderDesc;
+use rust_v::scene::load_scene_str;
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `../shared` beside the repository, if present.
+pub fn shared(rel: &str) -> Option<PathBuf> {
+    let p = root().join("../shared").join(rel);
+    p.exists().then_some(p)
+}
+
+/// Renders a scene given as RON text with overrides; returns the film.
+pub fn render_str(ron: &str, overrides: &RenderDesc) -> Film {
+    let scene = load_scene_str(ron, Path::new("test.ron"), overrides).expect("test scene loads");
+    let s = &scene.settings;
+    let mut film = Film::new(s.width, s.height);
+    let stop = AtomicBool::new(false);
+    let stats = render(&scene, &mut film, 0..s.spp, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
+    assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
+    film
+}
+
+/// Mean and standard error of the per-pixel means of channel `c` (0 = X, 1 = Y, 2 = Z).
+pub fn mean_and_stderr(film: &Film, c: usize) -> (f64, f64) {
+    let v: Vec<f64> = film.mean_xyz().iter().map(|p| p[c]).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Runs the rust-v binary.
+pub fn rust_v(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rust-v")).args(args).current_dir(root()).output().expect("binary runs")
+}
+
+/// A fresh temporary directory for one test.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("rust-v-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}

@@ -1,0 +1,10 @@
+//! Integration tests, one binary organised by area (ripgrep style).
+//!
+//! Tests that render keep images tiny (16x16 to 32x32) and sample counts
+//! small; statistical tests state their tolerance and where it comes from.
+
+mod common;
+
+mod cli;
+mod furnace;
+mod scenes;
