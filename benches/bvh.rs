@@ -24,10 +24,7 @@ fn uniform(rng: &mut Pcg32) -> f32 {
 
 /// Median wall time of 5 builds inside a pool of `threads` threads.
 fn build_time(bounds: &[Aabb], threads: usize) -> (Duration, Bvh) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
     let mut times = Vec::new();
     let mut bvh = Bvh::default();
     for _ in 0..5 {
@@ -53,19 +50,13 @@ fn trace(mesh: &Mesh, rays: &[Ray]) -> (f64, f64) {
         }
         times.push(t.elapsed());
     }
-    (
-        rays.len() as f64 / median(times).as_secs_f64(),
-        hits as f64 / rays.len() as f64,
-    )
+    (rays.len() as f64 / median(times).as_secs_f64(), hits as f64 / rays.len() as f64)
 }
 
 fn main() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/dragon_vrip.ply.gz");
     if !path.exists() {
-        println!(
-            "bvh bench skipped: {} not found (shared/ is expected beside the repository)",
-            path.display()
-        );
+        println!("bvh bench skipped: {} not found (shared/ is expected beside the repository)", path.display());
         return;
     }
     let t = Instant::now();
@@ -99,11 +90,7 @@ fn main() {
     let primary: Vec<Ray> = (0..res * res)
         .map(|i| {
             let (x, y) = ((i % res) as f32 + 0.5, (i / res) as f32 + 0.5);
-            let dir = Vec3::new(
-                (2.0 * x / res as f32 - 1.0) * half,
-                (1.0 - 2.0 * y / res as f32) * half,
-                -1.0,
-            );
+            let dir = Vec3::new((2.0 * x / res as f32 - 1.0) * half, (1.0 - 2.0 * y / res as f32) * half, -1.0);
             Ray::new(eye, dir.normalize())
         })
         .collect();
@@ -121,45 +108,15 @@ fn main() {
     let (prim_rate, prim_hits) = trace(&mesh, &primary);
     let (inc_rate, inc_hits) = trace(&mesh, &incoherent);
 
-    println!(
-        "BVH benchmark: {} ({n} triangles, {} degenerate dropped)",
-        path.display(),
-        mesh.degenerate_dropped()
-    );
+    println!("BVH benchmark: {} ({n} triangles, {} degenerate dropped)", path.display(), mesh.degenerate_dropped());
     println!("| measure                          | value        |");
     println!("|----------------------------------|--------------|");
-    println!(
-        "| load (gunzip + parse + BVH)      | {:>9.3} s  |",
-        load.as_secs_f64()
-    );
-    println!(
-        "| BVH build, 1 thread (median/5)   | {:>9.3} s  |",
-        build1.as_secs_f64()
-    );
-    println!(
-        "| BVH build, 2 threads (median/5)  | {:>9.3} s  |",
-        build2.as_secs_f64()
-    );
-    println!(
-        "| nodes                            | {:>12} |",
-        mb.node_count()
-    );
-    println!(
-        "| BVH bytes / triangle             | {:>12.1} |",
-        mb.memory_bytes() as f64 / n as f64
-    );
-    println!(
-        "| SAH cost                         | {:>12.2} |",
-        mb.sah_cost()
-    );
-    println!(
-        "| primary rays/s, 1 thread         | {:>10.2} M | ({:.0}% hit)",
-        prim_rate / 1e6,
-        prim_hits * 100.0
-    );
-    println!(
-        "| incoherent rays/s, 1 thread      | {:>10.2} M | ({:.0}% hit)",
-        inc_rate / 1e6,
-        inc_hits * 100.0
-    );
+    println!("| load (gunzip + parse + BVH)      | {:>9.3} s  |", load.as_secs_f64());
+    println!("| BVH build, 1 thread (median/5)   | {:>9.3} s  |", build1.as_secs_f64());
+    println!("| BVH build, 2 threads (median/5)  | {:>9.3} s  |", build2.as_secs_f64());
+    println!("| nodes                            | {:>12} |", mb.node_count());
+    println!("| BVH bytes / triangle             | {:>12.1} |", mb.memory_bytes() as f64 / n as f64);
+    println!("| SAH cost                         | {:>12.2} |", mb.sah_cost());
+    println!("| primary rays/s, 1 thread         | {:>10.2} M | ({:.0}% hit)", prim_rate / 1e6, prim_hits * 100.0);
+    println!("| incoherent rays/s, 1 thread      | {:>10.2} M | ({:.0}% hit)", inc_rate / 1e6, inc_hits * 100.0);
 }

@@ -78,31 +78,15 @@ impl RayBox {
         // (-inf, inf) or empty, except when the origin lies exactly on a slab plane where
         // 0 * inf = NaN, which the comparisons below ignore (the ray counts as inside).
         let inv = Vec3::ONE / ray.dir;
-        RayBox {
-            o: ray.origin,
-            inv,
-            neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
-        }
+        RayBox { o: ray.origin, inv, neg: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0] }
     }
 
     /// True if the ray enters the node's box with `t < t_max` (and exits at `t >= 0`).
     #[inline(always)]
     fn hits(&self, n: &Node, t_max: f32) -> bool {
-        let (nx, fx) = if self.neg[0] {
-            (n.max.x, n.min.x)
-        } else {
-            (n.min.x, n.max.x)
-        };
-        let (ny, fy) = if self.neg[1] {
-            (n.max.y, n.min.y)
-        } else {
-            (n.min.y, n.max.y)
-        };
-        let (nz, fz) = if self.neg[2] {
-            (n.max.z, n.min.z)
-        } else {
-            (n.min.z, n.max.z)
-        };
+        let (nx, fx) = if self.neg[0] { (n.max.x, n.min.x) } else { (n.min.x, n.max.x) };
+        let (ny, fy) = if self.neg[1] { (n.max.y, n.min.y) } else { (n.min.y, n.max.y) };
+        let (nz, fz) = if self.neg[2] { (n.max.z, n.min.z) } else { (n.min.z, n.max.z) };
         let mut t0 = 0.0f32;
         let mut t1 = t_max;
         let a = (nx - self.o.x) * self.inv.x;
@@ -124,21 +108,9 @@ impl RayBox {
     /// Entry distance into the node's box if the ray hits it before `t_max`, else infinity.
     #[inline(always)]
     fn entry(&self, n: &Node, t_max: f32) -> f32 {
-        let (nx, fx) = if self.neg[0] {
-            (n.max.x, n.min.x)
-        } else {
-            (n.min.x, n.max.x)
-        };
-        let (ny, fy) = if self.neg[1] {
-            (n.max.y, n.min.y)
-        } else {
-            (n.min.y, n.max.y)
-        };
-        let (nz, fz) = if self.neg[2] {
-            (n.max.z, n.min.z)
-        } else {
-            (n.min.z, n.max.z)
-        };
+        let (nx, fx) = if self.neg[0] { (n.max.x, n.min.x) } else { (n.min.x, n.max.x) };
+        let (ny, fy) = if self.neg[1] { (n.max.y, n.min.y) } else { (n.min.y, n.max.y) };
+        let (nz, fz) = if self.neg[2] { (n.max.z, n.min.z) } else { (n.min.z, n.max.z) };
         let mut t0 = 0.0f32;
         let mut t1 = t_max;
         let a = (nx - self.o.x) * self.inv.x;
@@ -167,23 +139,14 @@ impl Bvh {
     }
 
     fn build_with_threshold(prim_bounds: &[Aabb], threshold: usize) -> Bvh {
-        let mut prims: Vec<BuildPrim> = prim_bounds
-            .iter()
-            .enumerate()
-            .map(|(i, b)| BuildPrim {
-                bounds: *b,
-                index: i as u32,
-            })
-            .collect();
+        let mut prims: Vec<BuildPrim> =
+            prim_bounds.iter().enumerate().map(|(i, b)| BuildPrim { bounds: *b, index: i as u32 }).collect();
         let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
         if !prims.is_empty() {
             build_node(&mut prims, 0, 0, &mut nodes, threshold);
         }
         nodes.shrink_to_fit();
-        Bvh {
-            nodes,
-            order: prims.iter().map(|p| p.index).collect(),
-        }
+        Bvh { nodes, order: prims.iter().map(|p| p.index).collect() }
     }
 
     /// Primitive order of the leaves: leaf ranges index into this; `prim_order()[k]` is an
@@ -195,10 +158,7 @@ impl Bvh {
 
     /// Bounds of everything (empty for an empty tree).
     pub fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, |n| Aabb {
-            min: n.min,
-            max: n.max,
-        })
+        self.nodes.first().map_or(Aabb::EMPTY, |n| Aabb { min: n.min, max: n.max })
     }
 
     /// Number of nodes.
@@ -217,13 +177,7 @@ impl Bvh {
         let Some(root) = self.nodes.first() else {
             return 0.0;
         };
-        let area = |n: &Node| {
-            Aabb {
-                min: n.min,
-                max: n.max,
-            }
-            .surface_area() as f64
-        };
+        let area = |n: &Node| Aabb { min: n.min, max: n.max }.surface_area() as f64;
         let root_area = area(root);
         if !(root_area > 0.0) {
             return 0.0;
@@ -231,13 +185,7 @@ impl Bvh {
         let cost: f64 = self
             .nodes
             .iter()
-            .map(|n| {
-                if n.count == 0 {
-                    area(n) * TRAVERSAL_COST as f64
-                } else {
-                    area(n) * n.count as f64
-                }
-            })
+            .map(|n| if n.count == 0 { area(n) * TRAVERSAL_COST as f64 } else { area(n) * n.count as f64 })
             .sum();
         (cost / root_area) as f32
     }
@@ -249,12 +197,7 @@ impl Bvh {
     /// which returns `Some((t, payload))` on a hit closer than `t_max`; shrinks `t_max`;
     /// returns the closest payload.
     #[inline]
-    pub fn intersect<H>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        mut hit: impl FnMut(u32, f32) -> Option<(f32, H)>,
-    ) -> Option<H> {
+    pub fn intersect<H>(&self, ray: &Ray, t_max: f32, mut hit: impl FnMut(u32, f32) -> Option<(f32, H)>) -> Option<H> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -376,13 +319,7 @@ fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
 
 /// Builds the subtree over `prims` (slots `first..first + prims.len()`), appending its
 /// nodes depth-first to `nodes`; node offsets are relative to the start of `nodes`.
-fn build_node(
-    prims: &mut [BuildPrim],
-    first: u32,
-    depth: u32,
-    nodes: &mut Vec<Node>,
-    threshold: usize,
-) {
+fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<Node>, threshold: usize) {
     let n = prims.len();
     let mut bounds = Aabb::EMPTY;
     let mut cb = Aabb::EMPTY;
@@ -391,14 +328,7 @@ fn build_node(
         cb = cb.grow(p.centroid());
     }
     let me = nodes.len();
-    nodes.push(Node {
-        min: bounds.min,
-        max: bounds.max,
-        offset: first,
-        count: n as u16,
-        axis: 0,
-        _pad: 0,
-    });
+    nodes.push(Node { min: bounds.min, max: bounds.max, offset: first, count: n as u16, axis: 0, _pad: 0 });
     if n == 1 {
         return;
     }
@@ -409,10 +339,7 @@ fn build_node(
     let force_median = depth + ceil_log2(n) + 2 >= STACK as u32;
     let mut split: Option<(usize, usize)> = None; // (axis, last bin on the left)
     if !force_median {
-        let mut bins = [[Bin {
-            bounds: Aabb::EMPTY,
-            count: 0,
-        }; BINS]; 3];
+        let mut bins = [[Bin { bounds: Aabb::EMPTY, count: 0 }; BINS]; 3];
         let mut scale = [0.0f32; 3];
         for a in 0..3 {
             if extent[a] > 0.0 {
@@ -457,11 +384,7 @@ fn build_node(
             }
         }
         let area = bounds.surface_area();
-        let split_cost = if area > 0.0 {
-            TRAVERSAL_COST + best_cost / area
-        } else {
-            f32::INFINITY
-        };
+        let split_cost = if area > 0.0 { TRAVERSAL_COST + best_cost / area } else { f32::INFINITY };
         if n <= MAX_LEAF && (n as f32) <= split_cost {
             return;
         }
@@ -489,9 +412,7 @@ fn build_node(
             };
             let mid = n / 2;
             prims.select_nth_unstable_by(mid, |p, q| {
-                p.centroid()[a]
-                    .total_cmp(&q.centroid()[a])
-                    .then(p.index.cmp(&q.index))
+                p.centroid()[a].total_cmp(&q.centroid()[a]).then(p.index.cmp(&q.index))
             });
             (mid, a)
         }
@@ -572,11 +493,7 @@ mod tests {
             .map(|_| {
                 let c = v() * 10.0 - 5.0;
                 let s = 0.1 + uniform_len(&mut v);
-                Triangle::new(
-                    c + (v() - 0.5) * s,
-                    c + (v() - 0.5) * s,
-                    c + (v() - 0.5) * s,
-                )
+                Triangle::new(c + (v() - 0.5) * s, c + (v() - 0.5) * s, c + (v() - 0.5) * s)
             })
             .collect()
     }
@@ -597,10 +514,7 @@ mod tests {
         assert!(bvh.sah_cost() > 1.0);
         let mut order = bvh.prim_order().to_vec();
         order.sort();
-        assert!(
-            order.iter().enumerate().all(|(i, &k)| i as u32 == k),
-            "prim_order is a permutation"
-        );
+        assert!(order.iter().enumerate().all(|(i, &k)| i as u32 == k), "prim_order is a permutation");
         let mut rng = Pcg32::new(2, 2);
         let mut hits = 0;
         for i in 0..10_000 {
@@ -619,25 +533,18 @@ mod tests {
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             let got = bvh.intersect(&ray, t_max, |k, tm| {
                 let idx = bvh.prim_order()[k as usize];
-                tris[idx as usize]
-                    .intersect(&ray, tm)
-                    .map(|h| (h.t, (h.t, idx)))
+                tris[idx as usize].intersect(&ray, tm).map(|h| (h.t, (h.t, idx)))
             });
             match (brute, got) {
                 (None, None) => {}
                 (Some((tb, kb)), Some((tg, kg))) => {
                     hits += 1;
                     assert!((tb - tg).abs() <= 1e-5 * tb, "ray {i}: t {tb} vs {tg}");
-                    assert!(
-                        kb == kg || (tb - tg).abs() <= 1e-6 * tb,
-                        "ray {i}: triangle {kb} vs {kg}"
-                    );
+                    assert!(kb == kg || (tb - tg).abs() <= 1e-6 * tb, "ray {i}: triangle {kb} vs {kg}");
                 }
                 other => panic!("ray {i}: brute force {:?} vs bvh {:?}", other.0, other.1),
             }
-            let occ = bvh.occluded(&ray, t_max, |k, tm| {
-                tris[bvh.prim_order()[k as usize] as usize].occluded(&ray, tm)
-            });
+            let occ = bvh.occluded(&ray, t_max, |k, tm| tris[bvh.prim_order()[k as usize] as usize].occluded(&ray, tm));
             assert_eq!(occ, brute.is_some(), "ray {i}: occluded");
         }
         assert!(hits > 2000, "test rays should hit often ({hits})");
@@ -649,10 +556,7 @@ mod tests {
         let b: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
         let reference = Bvh::build_with_threshold(&b, 64);
         for threads in [1, 2] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let t = pool.install(|| Bvh::build_with_threshold(&b, 64));
             assert_eq!(t.nodes, reference.nodes, "{threads} threads");
             assert_eq!(t.order, reference.order);
@@ -666,38 +570,22 @@ mod tests {
     fn empty_identical_and_flat_inputs() {
         let empty = Bvh::build(&[]);
         assert_eq!(empty.node_count(), 0);
-        assert!(
-            empty
-                .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY, |_, _| Some(
-                    (1.0, ())
-                ))
-                .is_none()
-        );
+        assert!(empty.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY, |_, _| Some((1.0, ()))).is_none());
         // Many identical boxes: median splits, bounded depth, all reachable.
         let same = vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 1000];
         let bvh = Bvh::build(&same);
         let mut seen = 0;
-        bvh.occluded(
-            &Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z),
-            f32::INFINITY,
-            |_, _| {
-                seen += 1;
-                false
-            },
-        );
+        bvh.occluded(&Ray::new(Vec3::new(0.5, 0.5, -1.0), Vec3::Z), f32::INFINITY, |_, _| {
+            seen += 1;
+            false
+        });
         assert_eq!(seen, 1000);
         // A box flat in z, hit by a ray lying in its plane and by a ray with zero components.
         let flat = [Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0))];
         let bvh = Bvh::build(&flat);
         let hit = |r: Ray| bvh.occluded(&r, f32::INFINITY, |_, _| true);
         assert!(hit(Ray::new(Vec3::new(-1.0, 0.5, 0.0), Vec3::X)));
-        assert!(hit(Ray::new(
-            Vec3::new(0.5, 0.5, 1.0),
-            Vec3::new(0.0, -0.0, -1.0)
-        )));
-        assert!(!hit(Ray::new(
-            Vec3::new(1.5, 0.5, 1.0),
-            Vec3::new(0.0, -0.0, -1.0)
-        )));
+        assert!(hit(Ray::new(Vec3::new(0.5, 0.5, 1.0), Vec3::new(0.0, -0.0, -1.0))));
+        assert!(!hit(Ray::new(Vec3::new(1.5, 0.5, 1.0), Vec3::new(0.0, -0.0, -1.0))));
     }
 }

@@ -159,7 +159,10 @@ fn check_output_extension(output: &Path) -> Result<()> {
 
 fn report(scene: &Scene, stats: &rust_v::render::RenderStats, output: &Path, quiet: bool) {
     if stats.invalid_samples > 0 {
-        eprintln!("rust-v: warning: {} samples were NaN or infinite and were dropped (a bug: please report it)", stats.invalid_samples);
+        eprintln!(
+            "rust-v: warning: {} samples were NaN or infinite and were dropped (a bug: please report it)",
+            stats.invalid_samples
+        );
     }
     if !quiet {
         let samples = stats.passes as f64 * scene.settings.width as f64 * scene.settings.height as f64;

@@ -83,7 +83,9 @@ impl Light {
         let sides = |two: bool| if two { 2.0 } else { 1.0 };
         match self {
             Light::Point { .. } => 4.0 * PI * mean,
-            Light::Sphere { sphere, two_sided, .. } => sides(*two_sided) * PI * 4.0 * PI * sphere.radius * sphere.radius * mean,
+            Light::Sphere { sphere, two_sided, .. } => {
+                sides(*two_sided) * PI * 4.0 * PI * sphere.radius * sphere.radius * mean
+            }
             Light::Disk { disk, two_sided, .. } => sides(*two_sided) * PI * PI * disk.radius * disk.radius * mean,
         }
     }
@@ -214,7 +216,11 @@ mod tests {
     /// Also every sampled direction hits the sphere at the returned point.
     #[test]
     fn sphere_light_pdf_integrates_to_one_and_samples_hit() {
-        let light = Light::Sphere { sphere: Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5), radiance: Spectrum::ONE, two_sided: false };
+        let light = Light::Sphere {
+            sphere: Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5),
+            radiance: Spectrum::ONE,
+            two_sided: false,
+        };
         let p = Vec3::new(0.3, 0.0, 0.1);
         let mut s = Sampler::new(1, 1, 1);
         let n = 200_000;

@@ -182,11 +182,7 @@ impl<const N: usize> Lambdas<N> {
         for (o, &p) in out.iter_mut().zip(&self.pos) {
             let i0 = (p as usize).min(N_BINS - 1);
             let frac = p - i0 as f32;
-            *o = if frac <= 0.0 || i0 + 1 >= N_BINS {
-                s.0[i0]
-            } else {
-                s.0[i0] * (1.0 - frac) + s.0[i0 + 1] * frac
-            };
+            *o = if frac <= 0.0 || i0 + 1 >= N_BINS { s.0[i0] } else { s.0[i0] * (1.0 - frac) + s.0[i0 + 1] * frac };
         }
         Sampled(out)
     }

@@ -38,7 +38,18 @@ fn the_good_scene_renders() {
     let path = dir.join("good.ron");
     std::fs::write(&path, GOOD).unwrap();
     let out = dir.join("good.png");
-    let o = rust_v(&["render", path.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "8", "--height", "6", "--spp", "1"]);
+    let o = rust_v(&[
+        "render",
+        path.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "--spp",
+        "1",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("pass 1/1") && err.contains("Msamples/s"), "progress bar: {err}");
@@ -69,7 +80,10 @@ fn unknown_field_is_an_error_with_position() {
 #[test]
 fn unknown_colour_and_material_names() {
     let err = fails_with(&GOOD.replace("Constant(0.5)", "ColorChecker(\"mauve\")"), &[]);
-    assert!(err.contains("materials.\"white\".reflectance") && err.contains("mauve") && err.contains("dark skin"), "{err}");
+    assert!(
+        err.contains("materials.\"white\".reflectance") && err.contains("mauve") && err.contains("dark skin"),
+        "{err}"
+    );
     let err = fails_with(&GOOD.replace("material: \"white\"", "material: \"whte\""), &[]);
     assert!(err.contains("objects[0].material") && err.contains("whte"), "{err}");
     let err = fails_with(&GOOD.replace("Lambertian(", "Lambertan("), &[]);
@@ -85,7 +99,8 @@ fn missing_and_broken_meshes() {
     let dir = temp_dir("broken-mesh");
     std::fs::write(dir.join("broken.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").unwrap();
     let scene = dir.join("bad.ron");
-    std::fs::write(&scene, GOOD.replace("Sphere(center: (0, 1, 0), radius: 0.5)", "Mesh(path: \"broken.ply\")")).unwrap();
+    std::fs::write(&scene, GOOD.replace("Sphere(center: (0, 1, 0), radius: 0.5)", "Mesh(path: \"broken.ply\")"))
+        .unwrap();
     let o = rust_v(&["render", scene.to_str().unwrap(), "-o", dir.join("o.png").to_str().unwrap(), "--quiet"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("broken.ply") && !err.contains("panicked"), "{err}");
@@ -107,7 +122,19 @@ fn zero_and_negative_sizes() {
 fn help_documents_every_render_flag() {
     let o = rust_v(&["render", "--help"]);
     let help = String::from_utf8_lossy(&o.stdout);
-    for flag in ["--output", "--spp", "--seed", "--threads", "--width", "--height", "--quiet", "--integrator", "--wavelengths", "--packet-size", "--max-bounces"] {
+    for flag in [
+        "--output",
+        "--spp",
+        "--seed",
+        "--threads",
+        "--width",
+        "--height",
+        "--quiet",
+        "--integrator",
+        "--wavelengths",
+        "--packet-size",
+        "--max-bounces",
+    ] {
         assert!(help.contains(flag), "--help lacks {flag}");
     }
 }

@@ -56,10 +56,13 @@ fn spectral_packets_pass_the_furnace() {
     for how in ["hero", "random"] {
         let film = render_str(
             &furnace(material, "spectral", 0.5),
-            &RenderDesc { wavelengths: Some(match how {
-                "hero" => rust_v::scene::desc::WavelengthsKind::Hero,
-                _ => rust_v::scene::desc::WavelengthsKind::Random,
-            }), ..Default::default() },
+            &RenderDesc {
+                wavelengths: Some(match how {
+                    "hero" => rust_v::scene::desc::WavelengthsKind::Hero,
+                    _ => rust_v::scene::desc::WavelengthsKind::Random,
+                }),
+                ..Default::default()
+            },
         );
         let (mean, se) = mean_and_stderr(&film, 1);
         assert!((mean - 2.0).abs() < 5.0 * se + 4e-3, "{how}: Y = {mean} ± {se}");

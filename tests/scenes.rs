@@ -20,7 +20,19 @@ fn every_scene_renders_at_16x16() {
     assert!(files.len() >= 2, "expected scene files, found {files:?}");
     for scene in files {
         let out = dir.join(format!("{}.png", scene.file_stem().unwrap().to_string_lossy()));
-        let o = rust_v(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", "16", "--height", "16", "--spp", "2", "--quiet"]);
+        let o = rust_v(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "2",
+            "--quiet",
+        ]);
         assert!(o.status.success(), "{}: {}", scene.display(), String::from_utf8_lossy(&o.stderr));
         let img = image::open(&out).expect("output is a PNG");
         assert_eq!((img.width(), img.height()), (16, 16));
@@ -36,7 +48,21 @@ fn render_is_bit_identical_for_any_thread_count() {
     let mut outputs = Vec::new();
     for threads in ["1", "2", "3"] {
         let out = dir.join(format!("t{threads}.exr"));
-        let o = rust_v(&["render", "scenes/cornell.ron", "-o", out.to_str().unwrap(), "--width", "32", "--height", "32", "--spp", "4", "--threads", threads, "--quiet"]);
+        let o = rust_v(&[
+            "render",
+            "scenes/cornell.ron",
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp",
+            "4",
+            "--threads",
+            threads,
+            "--quiet",
+        ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         outputs.push(std::fs::read(&out).unwrap());
     }

@@ -30,7 +30,7 @@ mod specular;
 
 pub use dielectric::Dielectric;
 pub use fresnel::{fresnel_dielectric, refract};
-pub use ior::{Ior, named_glass, NAMED_GLASSES};
+pub use ior::{Ior, NAMED_GLASSES, named_glass};
 pub use lambertian::Lambertian;
 pub use oren_nayar::OrenNayar;
 pub use specular::Mirror;

@@ -26,7 +26,13 @@ impl Mirror {
         if wi.z == 0.0 {
             return None;
         }
-        Some(BsdfSample { wi, f: lambdas.sample(&self.reflectance) * (1.0 / wi.z.abs()), pdf: 1.0, is_delta: true, eta: 1.0 })
+        Some(BsdfSample {
+            wi,
+            f: lambdas.sample(&self.reflectance) * (1.0 / wi.z.abs()),
+            pdf: 1.0,
+            is_delta: true,
+            eta: 1.0,
+        })
     }
 }
 

@@ -114,8 +114,7 @@ mod tests {
 
     #[test]
     fn y_bar_555_is_one_in_5nm_table() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../shared/data/cmf_1931_2deg_360_830_5nm.csv");
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/cmf_1931_2deg_360_830_5nm.csv");
         let Ok(text) = std::fs::read_to_string(&path) else {
             println!("skipping: {} not found", path.display());
             return;
@@ -131,10 +130,7 @@ mod tests {
         assert_eq!(found, Some(1.0));
         // Our 10 nm bins are a subset of the 5 nm table: spot-check that they agree exactly.
         for line in text.lines().skip(1) {
-            let cols: Vec<f64> = line
-                .split(',')
-                .filter_map(|c| c.trim().parse().ok())
-                .collect();
+            let cols: Vec<f64> = line.split(',').filter_map(|c| c.trim().parse().ok()).collect();
             if cols.len() != 4 {
                 continue;
             }

@@ -10,18 +10,12 @@ use core::ops::{Add, AddAssign, Div, Mul, Sub};
 /// XYZ -> linear sRGB matrix (row-major), as used by Mitsuba 3.
 // Digits kept exactly as published, even where f32 cannot hold them all.
 #[allow(clippy::excessive_precision)]
-pub const XYZ_TO_LINEAR_SRGB: [[f32; 3]; 3] = [
-    [3.240479, -1.537150, -0.498535],
-    [-0.969256, 1.875991, 0.041556],
-    [0.055648, -0.204043, 1.057311],
-];
+pub const XYZ_TO_LINEAR_SRGB: [[f32; 3]; 3] =
+    [[3.240479, -1.537150, -0.498535], [-0.969256, 1.875991, 0.041556], [0.055648, -0.204043, 1.057311]];
 
 /// Linear sRGB -> XYZ matrix (row-major), the inverse of [`XYZ_TO_LINEAR_SRGB`].
-pub const LINEAR_SRGB_TO_XYZ: [[f32; 3]; 3] = [
-    [0.412453, 0.357580, 0.180423],
-    [0.212671, 0.715160, 0.072169],
-    [0.019334, 0.119193, 0.950227],
-];
+pub const LINEAR_SRGB_TO_XYZ: [[f32; 3]; 3] =
+    [[0.412453, 0.357580, 0.180423], [0.212671, 0.715160, 0.072169], [0.019334, 0.119193, 0.950227]];
 
 #[inline]
 fn mat_mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
@@ -61,11 +55,7 @@ impl Xyz {
     #[inline]
     pub fn chromaticity(self) -> (f32, f32) {
         let s = self.x + self.y + self.z;
-        if s == 0.0 {
-            (0.0, 0.0)
-        } else {
-            (self.x / s, self.y / s)
-        }
+        if s == 0.0 { (0.0, 0.0) } else { (self.x / s, self.y / s) }
     }
 }
 
@@ -148,19 +138,13 @@ impl LinearSrgb {
     #[inline]
     pub fn encode(self) -> Srgb {
         let f = |v: f32| srgb_oetf(if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) });
-        Srgb {
-            r: f(self.r),
-            g: f(self.g),
-            b: f(self.b),
-        }
+        Srgb { r: f(self.r), g: f(self.g), b: f(self.b) }
     }
 
     /// Relative luminance Y (the middle row of [`LINEAR_SRGB_TO_XYZ`]).
     #[inline]
     pub fn luminance(self) -> f32 {
-        LINEAR_SRGB_TO_XYZ[1][0] * self.r
-            + LINEAR_SRGB_TO_XYZ[1][1] * self.g
-            + LINEAR_SRGB_TO_XYZ[1][2] * self.b
+        LINEAR_SRGB_TO_XYZ[1][0] * self.r + LINEAR_SRGB_TO_XYZ[1][1] * self.g + LINEAR_SRGB_TO_XYZ[1][2] * self.b
     }
 }
 
@@ -179,11 +163,7 @@ impl Srgb {
     /// Removes the transfer curve per channel.
     #[inline]
     pub fn decode(self) -> LinearSrgb {
-        LinearSrgb {
-            r: srgb_eotf(self.r),
-            g: srgb_eotf(self.g),
-            b: srgb_eotf(self.b),
-        }
+        LinearSrgb { r: srgb_eotf(self.r), g: srgb_eotf(self.g), b: srgb_eotf(self.b) }
     }
 }
 
@@ -192,22 +172,14 @@ impl Srgb {
 /// inputs follow the linear segment.
 #[inline]
 pub fn srgb_oetf(linear: f32) -> f32 {
-    if linear <= 0.003_130_8 {
-        12.92 * linear
-    } else {
-        1.055 * linear.powf(1.0 / 2.4) - 0.055
-    }
+    if linear <= 0.003_130_8 { 12.92 * linear } else { 1.055 * linear.powf(1.0 / 2.4) - 0.055 }
 }
 
 /// Inverse of [`srgb_oetf`]: encoded value -> linear light. `x / 12.92` for `x <= 0.04045`,
 /// else `((x + 0.055) / 1.055)^2.4`.
 #[inline]
 pub fn srgb_eotf(encoded: f32) -> f32 {
-    if encoded <= 0.040_45 {
-        encoded / 12.92
-    } else {
-        ((encoded + 0.055) / 1.055).powf(2.4)
-    }
+    if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
 }
 
 /// XYZ -> linear sRGB in f64 (same matrix as [`Xyz::to_linear_srgb`]), for the film, which
@@ -244,10 +216,7 @@ mod tests {
     fn srgb_white_is_d65() {
         // Linear sRGB white must map to the D65 white point xy = (0.3127, 0.3290) (IEC 61966-2-1).
         let (x, y) = LinearSrgb::new(1.0, 1.0, 1.0).to_xyz().chromaticity();
-        assert!(
-            (x - 0.3127).abs() < 1e-4 && (y - 0.3290).abs() < 1e-4,
-            "{x} {y}"
-        );
+        assert!((x - 0.3127).abs() < 1e-4 && (y - 0.3290).abs() < 1e-4, "{x} {y}");
         assert!((LinearSrgb::new(1.0, 1.0, 1.0).luminance() - 1.0).abs() < 1e-6);
     }
 
@@ -281,14 +250,7 @@ mod tests {
     #[test]
     fn encode_clamps_and_decode_inverts() {
         let s = LinearSrgb::new(-0.5, 2.0, f32::NAN).encode();
-        assert_eq!(
-            s,
-            Srgb {
-                r: 0.0,
-                g: srgb_oetf(1.0),
-                b: 0.0
-            }
-        );
+        assert_eq!(s, Srgb { r: 0.0, g: srgb_oetf(1.0), b: 0.0 });
         let l = LinearSrgb::new(0.2, 0.5, 0.9);
         let d = l.encode().decode();
         assert!((d.r - 0.2).abs() < 1e-5 && (d.g - 0.5).abs() < 1e-5 && (d.b - 0.9).abs() < 1e-5);

@@ -13,36 +13,24 @@ pub struct Aabb {
 
 impl Aabb {
     /// The empty box (identity of [`Aabb::union`]).
-    pub const EMPTY: Aabb = Aabb {
-        min: Vec3::splat(f32::INFINITY),
-        max: Vec3::splat(f32::NEG_INFINITY),
-    };
+    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
 
     /// The smallest box holding the two points `a` and `b` (in any order).
     #[inline]
     pub fn new(a: Vec3, b: Vec3) -> Aabb {
-        Aabb {
-            min: a.min(b),
-            max: a.max(b),
-        }
+        Aabb { min: a.min(b), max: a.max(b) }
     }
 
     /// The smallest box holding both boxes.
     #[inline]
     pub fn union(&self, o: &Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     /// The smallest box holding this box and the point `p`.
     #[inline]
     pub fn grow(&self, p: Vec3) -> Aabb {
-        Aabb {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
+        Aabb { min: self.min.min(p), max: self.max.max(p) }
     }
 
     /// The centre of the box.

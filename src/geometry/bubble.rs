@@ -20,11 +20,7 @@ pub struct Bubble {
 impl Bubble {
     /// A bubble around `center` with the given outer and inner radii.
     pub fn new(center: Vec3, outer_radius: f32, inner_radius: f32) -> Bubble {
-        Bubble {
-            center,
-            outer_radius,
-            inner_radius,
-        }
+        Bubble { center, outer_radius, inner_radius }
     }
 
     /// Closest hit with `0 < t < t_max` on either surface.
@@ -32,16 +28,12 @@ impl Bubble {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut t_max = t_max;
-        if let Some(t) =
-            sphere_roots(self.center, self.outer_radius, ray).and_then(|r| first_root(r, t_max))
-        {
+        if let Some(t) = sphere_roots(self.center, self.outer_radius, ray).and_then(|r| first_root(r, t_max)) {
             let (p, n) = reproject(self.center, self.outer_radius, ray.at(t));
             best = Some(Hit::flat(t, p, n));
             t_max = t;
         }
-        if let Some(t) =
-            sphere_roots(self.center, self.inner_radius, ray).and_then(|r| first_root(r, t_max))
-        {
+        if let Some(t) = sphere_roots(self.center, self.inner_radius, ray).and_then(|r| first_root(r, t_max)) {
             let (p, n) = reproject(self.center, self.inner_radius, ray.at(t));
             best = Some(Hit::flat(t, p, -n));
         }
@@ -51,12 +43,8 @@ impl Bubble {
     /// True if the ray hits either surface with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        sphere_roots(self.center, self.outer_radius, ray)
-            .and_then(|r| first_root(r, t_max))
-            .is_some()
-            || sphere_roots(self.center, self.inner_radius, ray)
-                .and_then(|r| first_root(r, t_max))
-                .is_some()
+        sphere_roots(self.center, self.outer_radius, ray).and_then(|r| first_root(r, t_max)).is_some()
+            || sphere_roots(self.center, self.inner_radius, ray).and_then(|r| first_root(r, t_max)).is_some()
     }
 
     /// Bounding box (of the outer sphere).
@@ -82,18 +70,13 @@ mod tests {
         let h = b.intersect(&r, f32::INFINITY).unwrap();
         assert!((h.t - 0.25).abs() < 1e-5, "t = {}", h.t);
         assert!((h.p - Vec3::new(0.0, 0.0, -1.5)).length() < 1e-6);
-        assert!(
-            (h.n - Vec3::Z).length() < 1e-6,
-            "inner normal points towards the centre"
-        );
+        assert!((h.n - Vec3::Z).length() < 1e-6, "inner normal points towards the centre");
         // Inside the shell, heading outward: the outer surface, outward normal.
         let r = Ray::new(Vec3::new(0.0, 0.0, -1.75), -Vec3::Z);
         let h = b.intersect(&r, f32::INFINITY).unwrap();
         assert!((h.t - 0.25).abs() < 1e-5 && (h.n - -Vec3::Z).length() < 1e-6);
         // From the cavity: the inner surface from inside, normal towards the centre.
-        let h = b
-            .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY)
-            .unwrap();
+        let h = b.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY).unwrap();
         assert!((h.t - 1.5).abs() < 1e-6 && (h.n - -Vec3::X).length() < 1e-6);
         assert!(b.occluded(&Ray::new(Vec3::ZERO, Vec3::X), 1.6));
         assert!(!b.occluded(&Ray::new(Vec3::ZERO, Vec3::X), 1.4));

@@ -16,10 +16,7 @@ pub struct Cuboid {
 impl Cuboid {
     /// The box spanned by two opposite corners (in any order).
     pub fn new(a: Vec3, b: Vec3) -> Cuboid {
-        Cuboid {
-            min: a.min(b),
-            max: a.max(b),
-        }
+        Cuboid { min: a.min(b), max: a.max(b) }
     }
 
     /// Entry and exit parameters with the axis of each, or None if the line misses.
@@ -69,11 +66,7 @@ impl Cuboid {
         // Entering through the face the ray faces: the one at min if d > 0.
         let at_max = (d > 0.0) != entering;
         let mut p = ray.at(t);
-        p[axis] = if at_max {
-            self.max[axis]
-        } else {
-            self.min[axis]
-        };
+        p[axis] = if at_max { self.max[axis] } else { self.min[axis] };
         // Keep the point inside the face despite rounding in the other coordinates.
         p = p.clamp(self.min, self.max);
         let mut n = Vec3::ZERO;
@@ -89,10 +82,7 @@ impl Cuboid {
 
     /// Bounding box (the box itself).
     pub fn bounds(&self) -> Aabb {
-        Aabb {
-            min: self.min,
-            max: self.max,
-        }
+        Aabb { min: self.min, max: self.max }
     }
 }
 
@@ -105,45 +95,23 @@ mod tests {
     #[test]
     fn outside_inside_and_axis_parallel() {
         let c = Cuboid::new(Vec3::new(1.0, 1.0, 1.0), Vec3::new(-1.0, -2.0, -3.0));
-        let h = c
-            .intersect(
-                &Ray::new(Vec3::new(0.0, 0.0, -10.0), Vec3::Z),
-                f32::INFINITY,
-            )
-            .unwrap();
+        let h = c.intersect(&Ray::new(Vec3::new(0.0, 0.0, -10.0), Vec3::Z), f32::INFINITY).unwrap();
         assert!((h.t - 7.0).abs() < 1e-6 && h.n == -Vec3::Z && h.p.z == -3.0);
         // From inside: the far face, outward normal.
-        let h = c
-            .intersect(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY)
-            .unwrap();
+        let h = c.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY).unwrap();
         assert!((h.t - 1.0).abs() < 1e-6 && h.n == Vec3::Z);
-        let h = c
-            .intersect(&Ray::new(Vec3::ZERO, -Vec3::Y), f32::INFINITY)
-            .unwrap();
+        let h = c.intersect(&Ray::new(Vec3::ZERO, -Vec3::Y), f32::INFINITY).unwrap();
         assert!((h.t - 2.0).abs() < 1e-6 && h.n == -Vec3::Y);
         // Parallel to a face, outside its slab: miss; with -0 components: no NaN.
-        assert!(
-            c.intersect(
-                &Ray::new(Vec3::new(0.0, 5.0, -10.0), Vec3::Z),
-                f32::INFINITY
-            )
-            .is_none()
-        );
-        let h = c
-            .intersect(
-                &Ray::new(Vec3::new(0.5, 0.5, 5.0), Vec3::new(-0.0, -0.0, -1.0)),
-                f32::INFINITY,
-            )
-            .unwrap();
+        assert!(c.intersect(&Ray::new(Vec3::new(0.0, 5.0, -10.0), Vec3::Z), f32::INFINITY).is_none());
+        let h = c.intersect(&Ray::new(Vec3::new(0.5, 0.5, 5.0), Vec3::new(-0.0, -0.0, -1.0)), f32::INFINITY).unwrap();
         assert!((h.t - 4.0).abs() < 1e-6 && h.n == Vec3::Z);
         assert!(!c.occluded(&Ray::new(Vec3::new(0.0, 0.0, -10.0), Vec3::Z), 6.9));
         // Spawned from the surface: outward rays escape; inward rays hit another face.
         let mut rng = Pcg32::new(3, 3);
         for _ in 0..2000 {
             let o = random_dir(&mut rng) * 10.0;
-            let h = c
-                .intersect(&Ray::new(o, (-o).normalize()), f32::INFINITY)
-                .unwrap();
+            let h = c.intersect(&Ray::new(o, (-o).normalize()), f32::INFINITY).unwrap();
             let d = random_dir(&mut rng);
             let r = Ray::spawn(h.p, h.n, d);
             match c.intersect(&r, f32::INFINITY) {

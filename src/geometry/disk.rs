@@ -18,11 +18,7 @@ pub struct Disk {
 impl Disk {
     /// A disk (the normal is normalised here).
     pub fn new(center: Vec3, normal: Vec3, radius: f32) -> Disk {
-        Disk {
-            center,
-            normal: normal.normalize(),
-            radius,
-        }
+        Disk { center, normal: normal.normalize(), radius }
     }
 
     #[inline]
@@ -61,18 +57,10 @@ mod tests {
     #[test]
     fn inside_and_just_outside_the_radius() {
         let d = Disk::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z, 2.0);
-        let h = d
-            .intersect(&Ray::new(Vec3::new(1.99, 0.0, 0.0), Vec3::Z), f32::INFINITY)
-            .unwrap();
+        let h = d.intersect(&Ray::new(Vec3::new(1.99, 0.0, 0.0), Vec3::Z), f32::INFINITY).unwrap();
         assert!((h.t - 5.0).abs() < 1e-6 && h.n == -Vec3::Z);
-        assert!(
-            d.intersect(&Ray::new(Vec3::new(2.01, 0.0, 0.0), Vec3::Z), f32::INFINITY)
-                .is_none()
-        );
-        assert!(
-            d.intersect(&Ray::new(Vec3::new(1.5, 1.5, 0.0), Vec3::Z), f32::INFINITY)
-                .is_none()
-        );
+        assert!(d.intersect(&Ray::new(Vec3::new(2.01, 0.0, 0.0), Vec3::Z), f32::INFINITY).is_none());
+        assert!(d.intersect(&Ray::new(Vec3::new(1.5, 1.5, 0.0), Vec3::Z), f32::INFINITY).is_none());
         assert!(d.occluded(&Ray::new(Vec3::new(0.0, 1.9, 0.0), Vec3::Z), 6.0));
         assert!(!d.occluded(&Ray::new(Vec3::new(0.0, 1.9, 0.0), Vec3::Z), 4.0));
         let b = d.bounds();

@@ -23,12 +23,6 @@ impl Hit {
     /// A hit whose shading normal is its geometric normal (analytic shapes).
     #[inline]
     pub fn flat(t: f32, p: Vec3, n: Vec3) -> Hit {
-        Hit {
-            t,
-            p,
-            n,
-            ns: n,
-            prim: 0,
-        }
+        Hit { t, p, n, ns: n, prim: 0 }
     }
 }

@@ -26,11 +26,7 @@ pub struct Transform {
 
 impl Default for Transform {
     fn default() -> Self {
-        Transform {
-            scale: Vec3::ONE,
-            rotate_deg: Vec3::ZERO,
-            translate: Vec3::ZERO,
-        }
+        Transform { scale: Vec3::ONE, rotate_deg: Vec3::ZERO, translate: Vec3::ZERO }
     }
 }
 
@@ -79,10 +75,7 @@ impl Mesh {
     /// singular transform is an error naming the file.
     pub fn load(path: &Path, transform: &Transform) -> Result<Mesh> {
         let raw = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().to_lowercase())
-            .unwrap_or_default();
+        let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
         let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
             let mut out = Vec::with_capacity(raw.len() * 4);
             flate2::read::MultiGzDecoder::new(raw.as_slice())
@@ -103,21 +96,13 @@ impl Mesh {
                 "unknown mesh format: expected a name ending in .obj, .ply, .obj.gz or .ply.gz",
             ));
         };
-        Mesh::build(positions, indices, normals, transform, &|m| {
-            Error::mesh(path, m)
-        })
+        Mesh::build(positions, indices, normals, transform, &|m| Error::mesh(path, m))
     }
 
     /// A mesh from positions, triangles (indices into `positions`, counter-clockwise
     /// front) and optional per-vertex normals; errors are [`Error::Settings`].
-    pub fn from_triangles(
-        positions: Vec<Vec3>,
-        indices: Vec<[u32; 3]>,
-        normals: Option<Vec<Vec3>>,
-    ) -> Result<Mesh> {
-        Mesh::build(positions, indices, normals, &Transform::default(), &|m| {
-            Error::Settings(format!("mesh: {m}"))
-        })
+    pub fn from_triangles(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, normals: Option<Vec<Vec3>>) -> Result<Mesh> {
+        Mesh::build(positions, indices, normals, &Transform::default(), &|m| Error::Settings(format!("mesh: {m}")))
     }
 
     fn build(
@@ -130,17 +115,11 @@ impl Mesh {
         let m = transform.linear();
         let det = m.determinant();
         if !(det != 0.0 && det.is_finite() && transform.translate.is_finite()) {
-            return Err(err(format!(
-                "transform {transform:?} is singular or not finite"
-            )));
+            return Err(err(format!("transform {transform:?} is singular or not finite")));
         }
         if let Some(ns) = &normals {
             if ns.len() != positions.len() {
-                return Err(err(format!(
-                    "{} normals for {} vertices",
-                    ns.len(),
-                    positions.len()
-                )));
+                return Err(err(format!("{} normals for {} vertices", ns.len(), positions.len())));
             }
         }
         for (i, p) in positions.iter_mut().enumerate() {
@@ -163,15 +142,9 @@ impl Mesh {
         let mut degenerate = 0;
         for (f, tri) in indices.iter().enumerate() {
             if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
-                return Err(err(format!(
-                    "triangle {f}: vertex index {bad} out of range (there are {nv} vertices)"
-                )));
+                return Err(err(format!("triangle {f}: vertex index {bad} out of range (there are {nv} vertices)")));
             }
-            let tri = if mirror {
-                [tri[0], tri[2], tri[1]]
-            } else {
-                *tri
-            };
+            let tri = if mirror { [tri[0], tri[2], tri[1]] } else { *tri };
             let [a, b, c] = tri.map(|i| positions[i as usize]);
             let area2 = (b - a).cross(c - a).length_squared();
             if area2 > 0.0 && area2.is_finite() {
@@ -181,10 +154,7 @@ impl Mesh {
             }
         }
         if kept.is_empty() {
-            return Err(err(format!(
-                "no valid triangles ({} given, {degenerate} of zero area)",
-                indices.len()
-            )));
+            return Err(err(format!("no valid triangles ({} given, {degenerate} of zero area)", indices.len())));
         }
         let bounds: Vec<Aabb> = kept
             .iter()
@@ -195,22 +165,9 @@ impl Mesh {
             .collect();
         let bvh = Bvh::build(&bounds);
         let order = bvh.prim_order();
-        let tris = order
-            .iter()
-            .map(|&i| kept[i as usize].map(|v| positions[v as usize]))
-            .collect();
-        let normal_idx = if normals.is_some() {
-            order.iter().map(|&i| kept[i as usize]).collect()
-        } else {
-            Vec::new()
-        };
-        Ok(Mesh {
-            tris,
-            normal_idx,
-            normals,
-            bvh,
-            degenerate,
-        })
+        let tris = order.iter().map(|&i| kept[i as usize].map(|v| positions[v as usize])).collect();
+        let normal_idx = if normals.is_some() { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
+        Ok(Mesh { tris, normal_idx, normals, bvh, degenerate })
     }
 
     /// Closest hit with `0 < t < t_max`. `prim` is the triangle's index in storage order.
@@ -219,16 +176,7 @@ impl Mesh {
         let tr = TriRay::new(ray);
         let h = self.bvh.intersect(ray, t_max, |k, t_max| {
             let [p0, p1, p2] = self.tris[k as usize];
-            tr.intersect(p0, p1, p2, t_max).map(|(t, b0, b1, b2)| {
-                (
-                    t,
-                    TriHit {
-                        k,
-                        t,
-                        b: [b0, b1, b2],
-                    },
-                )
-            })
+            tr.intersect(p0, p1, p2, t_max).map(|(t, b0, b1, b2)| (t, TriHit { k, t, b: [b0, b1, b2] }))
         })?;
         Some(self.make_hit(&h))
     }
@@ -241,20 +189,13 @@ impl Mesh {
         let mut ns = n;
         if let Some(normals) = &self.normals {
             let [i0, i1, i2] = self.normal_idx[h.k as usize];
-            let s =
-                normals[i0 as usize] * b0 + normals[i1 as usize] * b1 + normals[i2 as usize] * b2;
+            let s = normals[i0 as usize] * b0 + normals[i1 as usize] * b1 + normals[i2 as usize] * b2;
             let s = s.normalize_or_zero();
             if s != Vec3::ZERO {
                 ns = if s.dot(n) < 0.0 { -s } else { s };
             }
         }
-        Hit {
-            t: h.t,
-            p,
-            n,
-            ns,
-            prim: h.k,
-        }
+        Hit { t: h.t, p, n, ns, prim: h.k }
     }
 
     /// True if any triangle blocks the ray with `0 < t < t_max`.
@@ -309,15 +250,10 @@ type Loaded = (Vec<Vec3>, Vec<[u32; 3]>, Option<Vec<Vec3>>);
 /// Reads an OBJ file (all its objects and groups merged) with tobj, triangulated, with
 /// one index per vertex so that normals line up with positions.
 fn load_obj(data: &[u8], path: &Path) -> Result<Loaded> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
+    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let mut reader = std::io::BufReader::new(data);
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
-            .map_err(|e| Error::mesh(path, format!("OBJ parse error: {e}")))?;
+    let (models, _materials) = tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
+        .map_err(|e| Error::mesh(path, format!("OBJ parse error: {e}")))?;
     let mut positions = Vec::new();
     let mut indices = Vec::new();
     let mut normals = Vec::new();
@@ -326,39 +262,23 @@ fn load_obj(data: &[u8], path: &Path) -> Result<Loaded> {
         let m = &model.mesh;
         let base = positions.len() as u32;
         let nv = m.positions.len() / 3;
-        positions.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|c| Vec3::new(c[0], c[1], c[2])),
-        );
+        positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         if m.normals.len() == m.positions.len() {
-            normals.extend(
-                m.normals
-                    .chunks_exact(3)
-                    .map(|c| Vec3::new(c[0], c[1], c[2])),
-            );
+            normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         } else {
             all_normals = false;
         }
         if m.indices.len() % 3 != 0 {
             return Err(Error::mesh(
                 path,
-                format!(
-                    "object '{}': {} indices is not a multiple of 3",
-                    model.name,
-                    m.indices.len()
-                ),
+                format!("object '{}': {} indices is not a multiple of 3", model.name, m.indices.len()),
             ));
         }
         for c in m.indices.chunks_exact(3) {
             if let Some(&bad) = c.iter().find(|&&i| i as usize >= nv) {
                 return Err(Error::mesh(
                     path,
-                    format!(
-                        "object '{}': vertex index {} out of range ({nv} vertices)",
-                        model.name,
-                        bad + 1
-                    ),
+                    format!("object '{}': vertex index {} out of range ({nv} vertices)", model.name, bad + 1),
                 ));
             }
             indices.push([base + c[0], base + c[1], base + c[2]]);
@@ -385,20 +305,13 @@ mod tests {
 
     /// Triangles in file order, as vertex positions.
     fn tris_in_file_order(m: &Mesh) -> Vec<[Vec3; 3]> {
-        let mut v: Vec<(u32, [Vec3; 3])> = (0..m.triangle_count() as u32)
-            .map(|k| (m.original_index(k), m.triangle(k)))
-            .collect();
+        let mut v: Vec<(u32, [Vec3; 3])> =
+            (0..m.triangle_count() as u32).map(|k| (m.original_index(k), m.triangle(k))).collect();
         v.sort_by_key(|x| x.0);
         v.into_iter().map(|x| x.1).collect()
     }
 
-    const VERTS: [[f32; 3]; 5] = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.5, 0.5, 1.0],
-    ];
+    const VERTS: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.5, 0.5, 1.0]];
 
     fn ascii_ply(faces: &str, n_faces: usize) -> String {
         let mut s = String::from(
@@ -454,14 +367,9 @@ mod tests {
         std::fs::write(&b, binary_ply()).unwrap();
         let g = temp("quad.ply.gz");
         let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-        enc.write_all(ascii_ply("1 4 0 1 2 3\n0 3 0 1 4\n", 2).as_bytes())
-            .unwrap();
+        enc.write_all(ascii_ply("1 4 0 1 2 3\n0 3 0 1 4\n", 2).as_bytes()).unwrap();
         std::fs::write(&g, enc.finish().unwrap()).unwrap();
-        let (ma, mb, mg) = (
-            Mesh::load(&a, &t).unwrap(),
-            Mesh::load(&b, &t).unwrap(),
-            Mesh::load(&g, &t).unwrap(),
-        );
+        let (ma, mb, mg) = (Mesh::load(&a, &t).unwrap(), Mesh::load(&b, &t).unwrap(), Mesh::load(&g, &t).unwrap());
         assert_eq!(ma.triangle_count(), 3, "quad fan-triangulated + triangle");
         let v = VERTS.map(Vec3::from);
         let expect = vec![[v[0], v[1], v[2]], [v[0], v[2], v[3]], [v[0], v[1], v[4]]];
@@ -469,9 +377,7 @@ mod tests {
         assert_eq!(tris_in_file_order(&mb), expect);
         assert_eq!(tris_in_file_order(&mg), expect);
         assert!(!ma.has_normals());
-        let h = ma
-            .intersect(&Ray::new(Vec3::new(0.2, 0.7, 5.0), -Vec3::Z), f32::INFINITY)
-            .unwrap();
+        let h = ma.intersect(&Ray::new(Vec3::new(0.2, 0.7, 5.0), -Vec3::Z), f32::INFINITY).unwrap();
         assert!((h.t - 5.0).abs() < 1e-6 && h.n == Vec3::Z && h.ns == h.n);
     }
 
@@ -481,43 +387,24 @@ mod tests {
         let p = temp("truncated.ply");
         std::fs::write(&p, ascii_ply("1 4 0 1 2 3\n", 2)).unwrap();
         let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(
-            e.contains("truncated.ply") && e.contains("line 23") && e.contains("end of file"),
-            "{e}"
-        );
+        assert!(e.contains("truncated.ply") && e.contains("line 23") && e.contains("end of file"), "{e}");
         let p = temp("range.ply");
         std::fs::write(&p, ascii_ply("1 4 0 1 2 3\n0 3 0 1 5\n", 2)).unwrap();
         let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(
-            e.contains("range.ply") && e.contains("line 23") && e.contains("out of range"),
-            "{e}"
-        );
+        assert!(e.contains("range.ply") && e.contains("line 23") && e.contains("out of range"), "{e}");
         let p = temp("short.ply");
         std::fs::write(&p, ascii_ply("1 4 0 1 2 3\n0 3 0 1\n", 2)).unwrap();
         let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(
-            e.contains("short.ply") && e.contains("line 23") && e.contains("end of line"),
-            "{e}"
-        );
+        assert!(e.contains("short.ply") && e.contains("line 23") && e.contains("end of line"), "{e}");
         let p = temp("trunc_bin.ply");
         let b = binary_ply();
         std::fs::write(&p, &b[..b.len() - 3]).unwrap();
         let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(
-            e.contains("trunc_bin.ply") && e.contains("face") && e.contains("end of file"),
-            "{e}"
-        );
+        assert!(e.contains("trunc_bin.ply") && e.contains("face") && e.contains("end of file"), "{e}");
         let p = temp("bad.ply.gz");
         std::fs::write(&p, b"not gzip").unwrap();
-        assert!(
-            Mesh::load(&p, &t)
-                .unwrap_err()
-                .to_string()
-                .contains("bad.ply.gz")
-        );
-        let e = Mesh::load(&temp("missing.obj"), &t)
-            .unwrap_err()
-            .to_string();
+        assert!(Mesh::load(&p, &t).unwrap_err().to_string().contains("bad.ply.gz"));
+        let e = Mesh::load(&temp("missing.obj"), &t).unwrap_err().to_string();
         assert!(e.contains("missing.obj"), "{e}");
         let p = temp("degenerate.ply");
         std::fs::write(&p, ascii_ply("1 3 0 1 1\n", 1)).unwrap();
@@ -529,9 +416,7 @@ mod tests {
         (0..m.triangle_count() as u32)
             .filter_map(|k| {
                 let [a, b, c] = m.triangle(k);
-                Triangle::new(a, b, c)
-                    .intersect(ray, t_max)
-                    .map(|h| (h.t, k))
+                Triangle::new(a, b, c).intersect(ray, t_max).map(|h| (h.t, k))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
@@ -541,17 +426,12 @@ mod tests {
         let b = m.bounds();
         let mut rng = Pcg32::new(seed, 4);
         let point = |rng: &mut Pcg32| {
-            b.min + b.diagonal() * Vec3::new(uniform(rng), uniform(rng), uniform(rng)) * 1.4
-                - b.diagonal() * 0.2
+            b.min + b.diagonal() * Vec3::new(uniform(rng), uniform(rng), uniform(rng)) * 1.4 - b.diagonal() * 0.2
         };
         let mut hits = 0;
         for i in 0..n_rays {
             let o = point(&mut rng);
-            let d = if i % 2 == 0 {
-                random_dir(&mut rng)
-            } else {
-                (point(&mut rng) - o).normalize()
-            };
+            let d = if i % 2 == 0 { random_dir(&mut rng) } else { (point(&mut rng) - o).normalize() };
             let ray = Ray::new(o, d);
             let expect = brute(m, &ray, f32::INFINITY);
             let got = m.intersect(&ray, f32::INFINITY);
@@ -561,23 +441,12 @@ mod tests {
                     hits += 1;
                     assert!((t - h.t).abs() <= 1e-5 * t, "ray {i}: t {t} vs {}", h.t);
                     // Different triangles only for a tie (a ray through a shared edge or vertex).
-                    assert!(
-                        k == h.prim || (t - h.t).abs() <= 1e-6 * t,
-                        "ray {i}: triangle {k} vs {}",
-                        h.prim
-                    );
+                    assert!(k == h.prim || (t - h.t).abs() <= 1e-6 * t, "ray {i}: triangle {k} vs {}", h.prim);
                     assert!((h.n.length() - 1.0).abs() < 1e-5 && h.ns.dot(h.n) >= 0.0);
                 }
-                (e, g) => panic!(
-                    "ray {i}: brute force {e:?} vs bvh {:?}",
-                    g.map(|h| (h.t, h.prim))
-                ),
+                (e, g) => panic!("ray {i}: brute force {e:?} vs bvh {:?}", g.map(|h| (h.t, h.prim))),
             }
-            assert_eq!(
-                m.occluded(&ray, f32::INFINITY),
-                expect.is_some(),
-                "ray {i}: occluded"
-            );
+            assert_eq!(m.occluded(&ray, f32::INFINITY), expect.is_some(), "ray {i}: occluded");
         }
         assert!(hits > n_rays / 10, "{hits} hits");
     }
@@ -586,32 +455,20 @@ mod tests {
     fn bunny_obj_matches_brute_force() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/bunny.obj");
         let m = Mesh::load(&path, &Transform::default()).unwrap();
-        println!(
-            "bunny: {} triangles, {} degenerate dropped",
-            m.triangle_count(),
-            m.degenerate_dropped()
-        );
+        println!("bunny: {} triangles, {} degenerate dropped", m.triangle_count(), m.degenerate_dropped());
         assert_eq!(m.triangle_count() + m.degenerate_dropped(), 3674);
         check_against_brute_force(&m, 10_000, 1);
     }
 
     #[test]
     fn dragon_ply_gz_matches_brute_force() {
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/dragon_vrip_res4.ply.gz");
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/dragon_vrip_res4.ply.gz");
         if !path.exists() {
-            println!(
-                "skipped: {} not found (shared/ is expected beside the repository)",
-                path.display()
-            );
+            println!("skipped: {} not found (shared/ is expected beside the repository)", path.display());
             return;
         }
         let m = Mesh::load(&path, &Transform::default()).unwrap();
-        println!(
-            "dragon res4: {} triangles, {} degenerate dropped",
-            m.triangle_count(),
-            m.degenerate_dropped()
-        );
+        println!("dragon res4: {} triangles, {} degenerate dropped", m.triangle_count(), m.degenerate_dropped());
         assert_eq!(m.triangle_count() + m.degenerate_dropped(), 11_102);
         check_against_brute_force(&m, 10_000, 2);
     }
@@ -619,66 +476,29 @@ mod tests {
     #[test]
     fn transform_and_normals() {
         let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
-        let t = Transform {
-            scale: Vec3::new(2.0, 3.0, 1.0),
-            rotate_deg: Vec3::new(0.0, 0.0, 90.0),
-            translate: Vec3::Z,
-        };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &t, &|m| {
-            Error::Settings(m)
-        })
-        .unwrap();
+        let t =
+            Transform { scale: Vec3::new(2.0, 3.0, 1.0), rotate_deg: Vec3::new(0.0, 0.0, 90.0), translate: Vec3::Z };
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &t, &|m| Error::Settings(m)).unwrap();
         let [a, b, c] = m.triangle(0);
         assert!((a - Vec3::Z).length() < 1e-6);
         assert!((b - Vec3::new(0.0, 2.0, 1.0)).length() < 1e-6, "{b}");
         assert!((c - Vec3::new(-3.0, 0.0, 1.0)).length() < 1e-6, "{c}");
         // Mirroring keeps the front side (normal +z before and after).
-        let mirror = Transform {
-            scale: Vec3::new(-1.0, 1.0, 1.0),
-            ..Default::default()
-        };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &mirror, &|m| {
-            Error::Settings(m)
-        })
-        .unwrap();
-        let h = m
-            .intersect(
-                &Ray::new(Vec3::new(-0.2, 0.2, 1.0), -Vec3::Z),
-                f32::INFINITY,
-            )
-            .unwrap();
+        let mirror = Transform { scale: Vec3::new(-1.0, 1.0, 1.0), ..Default::default() };
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &mirror, &|m| Error::Settings(m)).unwrap();
+        let h = m.intersect(&Ray::new(Vec3::new(-0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
         assert_eq!(h.n, Vec3::Z);
         assert!(
-            Mesh::build(
-                pos.clone(),
-                vec![[0, 1, 2]],
-                None,
-                &Transform {
-                    scale: Vec3::ZERO,
-                    ..t
-                },
-                &|m| Error::Settings(m)
-            )
+            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &Transform { scale: Vec3::ZERO, ..t }, &|m| {
+                Error::Settings(m)
+            })
             .is_err()
         );
         // Interpolated vertex normals, flipped into n's hemisphere.
-        let ns = vec![
-            Vec3::new(0.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, -1.0),
-            Vec3::new(0.0, 0.0, -1.0),
-        ];
+        let ns = vec![Vec3::new(0.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(0.0, 0.0, -1.0)];
         let m = Mesh::from_triangles(pos.clone(), vec![[0, 1, 2]], Some(ns)).unwrap();
-        let h = m
-            .intersect(
-                &Ray::new(Vec3::new(0.5, 0.25, 1.0), -Vec3::Z),
-                f32::INFINITY,
-            )
-            .unwrap();
-        assert!(
-            h.ns.z > 0.0 && h.ns.x < 0.0 && (h.ns.length() - 1.0).abs() < 1e-6,
-            "{}",
-            h.ns
-        );
+        let h = m.intersect(&Ray::new(Vec3::new(0.5, 0.25, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
+        assert!(h.ns.z > 0.0 && h.ns.x < 0.0 && (h.ns.length() - 1.0).abs() < 1e-6, "{}", h.ns);
         let e = Mesh::from_triangles(pos, vec![[0, 1, 3]], None).unwrap_err();
         assert!(matches!(e, Error::Settings(_)) && e.to_string().contains("out of range"));
     }

@@ -34,10 +34,7 @@ pub(crate) fn project(n: Vec3, d: f32, p: Vec3) -> Vec3 {
 impl Plane {
     /// The plane through `point` with normal `normal` (normalised here).
     pub fn new(point: Vec3, normal: Vec3) -> Plane {
-        Plane {
-            point,
-            normal: normal.normalize(),
-        }
+        Plane { point, normal: normal.normalize() }
     }
 
     /// Closest hit with `0 < t < t_max`.
@@ -45,11 +42,7 @@ impl Plane {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let d = self.normal.dot(self.point);
         let t = plane_t(self.normal, d, ray, t_max)?;
-        Some(Hit::flat(
-            t,
-            project(self.normal, d, ray.at(t)),
-            self.normal,
-        ))
+        Some(Hit::flat(t, project(self.normal, d, ray.at(t)), self.normal))
     }
 
     /// True if the ray hits the plane with `0 < t < t_max`.
@@ -68,40 +61,25 @@ mod tests {
     #[test]
     fn hits_parallel_and_spawn() {
         let pl = Plane::new(Vec3::new(0.0, 1.0, 0.0), Vec3::Y);
-        let h = pl
-            .intersect(&Ray::new(Vec3::new(3.0, 5.0, 0.0), -Vec3::Y), f32::INFINITY)
-            .unwrap();
+        let h = pl.intersect(&Ray::new(Vec3::new(3.0, 5.0, 0.0), -Vec3::Y), f32::INFINITY).unwrap();
         assert!((h.t - 4.0).abs() < 1e-6 && h.n == Vec3::Y && h.p.y == 1.0);
         // From below: same normal.
-        let h = pl
-            .intersect(&Ray::new(Vec3::new(3.0, -1.0, 0.0), Vec3::Y), f32::INFINITY)
-            .unwrap();
+        let h = pl.intersect(&Ray::new(Vec3::new(3.0, -1.0, 0.0), Vec3::Y), f32::INFINITY).unwrap();
         assert!((h.t - 2.0).abs() < 1e-6 && h.n == Vec3::Y);
         // Parallel: no hit, no NaN, also when lying in the plane.
-        assert!(
-            pl.intersect(&Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::X), f32::INFINITY)
-                .is_none()
-        );
-        assert!(
-            pl.intersect(&Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::Z), f32::INFINITY)
-                .is_none()
-        );
+        assert!(pl.intersect(&Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::X), f32::INFINITY).is_none());
+        assert!(pl.intersect(&Ray::new(Vec3::new(0.0, 1.0, 0.0), Vec3::Z), f32::INFINITY).is_none());
         assert!(!pl.occluded(&Ray::new(Vec3::new(0.0, 1.0, 0.0), -Vec3::Z), f32::INFINITY));
         // Spawned rays from plane hits do not re-hit it, at several scales and tilts.
         let mut rng = Pcg32::new(5, 1);
         for scale in [1e-4f32, 1.0, 1e4] {
             let pl = Plane::new(Vec3::new(0.3, 1.0, -0.2) * scale, Vec3::new(0.2, 1.0, 0.1));
             for _ in 0..3000 {
-                let o =
-                    Vec3::new(uniform(&mut rng) - 0.5, 3.0, uniform(&mut rng) - 0.5) * 4.0 * scale;
-                let d =
-                    (Vec3::new(uniform(&mut rng) - 0.5, -1.0, uniform(&mut rng) - 0.5)).normalize();
+                let o = Vec3::new(uniform(&mut rng) - 0.5, 3.0, uniform(&mut rng) - 0.5) * 4.0 * scale;
+                let d = (Vec3::new(uniform(&mut rng) - 0.5, -1.0, uniform(&mut rng) - 0.5)).normalize();
                 let h = pl.intersect(&Ray::new(o, d), f32::INFINITY).unwrap();
                 let dir = random_dir(&mut rng);
-                assert!(
-                    !pl.occluded(&Ray::spawn(h.p, h.n, dir), f32::INFINITY),
-                    "scale {scale}"
-                );
+                assert!(!pl.occluded(&Ray::spawn(h.p, h.n, dir), f32::INFINITY), "scale {scale}");
             }
         }
     }

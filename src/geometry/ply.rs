@@ -96,23 +96,14 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
         .iter()
         .position(|e| e.name == "vertex")
         .ok_or_else(|| err("PLY header has no 'vertex' element".into()))?;
-    let fi = elements
-        .iter()
-        .position(|e| e.name == "face")
-        .ok_or_else(|| err("PLY header has no 'face' element".into()))?;
-    let find = |e: &Element, name: &str| {
-        e.props
-            .iter()
-            .position(|p| p.name == name && matches!(p.kind, Kind::Scalar(_)))
-    };
+    let fi =
+        elements.iter().position(|e| e.name == "face").ok_or_else(|| err("PLY header has no 'face' element".into()))?;
+    let find =
+        |e: &Element, name: &str| e.props.iter().position(|p| p.name == name && matches!(p.kind, Kind::Scalar(_)));
     let ve = &elements[vi];
     let mut xyz = [0; 3];
     for (k, name) in ["x", "y", "z"].iter().enumerate() {
-        xyz[k] = find(ve, name).ok_or_else(|| {
-            err(format!(
-                "PLY 'vertex' element has no scalar property '{name}'"
-            ))
-        })?;
+        xyz[k] = find(ve, name).ok_or_else(|| err(format!("PLY 'vertex' element has no scalar property '{name}'")))?;
     }
     let normal = match (find(ve, "nx"), find(ve, "ny"), find(ve, "nz")) {
         (Some(a), Some(b), Some(c)) => Some([a, b, c]),
@@ -122,41 +113,21 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
     let face_list = fe
         .props
         .iter()
-        .position(|p| {
-            (p.name == "vertex_indices" || p.name == "vertex_index")
-                && matches!(p.kind, Kind::List(..))
-        })
-        .ok_or_else(|| {
-            err("PLY 'face' element has no list property 'vertex_indices' or 'vertex_index'".into())
-        })?;
+        .position(|p| (p.name == "vertex_indices" || p.name == "vertex_index") && matches!(p.kind, Kind::List(..)))
+        .ok_or_else(|| err("PLY 'face' element has no list property 'vertex_indices' or 'vertex_index'".into()))?;
     if let Kind::List(c, i) = fe.props[face_list].kind {
         if !c.is_int() || !i.is_int() {
-            return Err(err(
-                "PLY face list must have integer count and index types".into()
-            ));
+            return Err(err("PLY face list must have integer count and index types".into()));
         }
     }
-    let layout = Layout {
-        xyz,
-        normal,
-        face_list,
-    };
+    let layout = Layout { xyz, normal, face_list };
     let mut out = PlyData {
         positions: Vec::with_capacity(ve.count),
         triangles: Vec::with_capacity(fe.count * 2),
         normals: normal.map(|_| Vec::with_capacity(ve.count)),
     };
     match format {
-        Format::Ascii => read_ascii(
-            body,
-            header_lines,
-            &elements,
-            vi,
-            fi,
-            &layout,
-            &mut out,
-            path,
-        )?,
+        Format::Ascii => read_ascii(body, header_lines, &elements, vi, fi, &layout, &mut out, path)?,
         _ => read_binary(body, format, &elements, vi, fi, &layout, &mut out, path)?,
     }
     Ok(out)
@@ -173,10 +144,7 @@ fn parse_header<'a>(data: &'a [u8], path: &Path) -> Result<Header<'a>> {
     loop {
         line_no += 1;
         let Some(len) = data[pos..].iter().position(|&b| b == b'\n') else {
-            return Err(err(
-                line_no,
-                "unexpected end of file in the PLY header (expected 'end_header')".into(),
-            ));
+            return Err(err(line_no, "unexpected end of file in the PLY header (expected 'end_header')".into()));
         };
         let line = std::str::from_utf8(&data[pos..pos + len])
             .map_err(|_| err(line_no, "PLY header is not ASCII text".into()))?
@@ -203,35 +171,31 @@ fn parse_header<'a>(data: &'a [u8], path: &Path) -> Result<Header<'a>> {
                 let (Some(name), Some(count), 3) = (words.get(1), words.get(2), words.len()) else {
                     return Err(err(line_no, "expected 'element <name> <count>'".into()));
                 };
-                let count = count
-                    .parse()
-                    .map_err(|_| err(line_no, format!("bad element count '{count}'")))?;
-                elements.push(Element {
-                    name: name.to_string(),
-                    count,
-                    props: Vec::new(),
-                });
+                let count = count.parse().map_err(|_| err(line_no, format!("bad element count '{count}'")))?;
+                elements.push(Element { name: name.to_string(), count, props: Vec::new() });
             }
             Some("property") => {
                 let Some(el) = elements.last_mut() else {
                     return Err(err(line_no, "'property' before any 'element'".into()));
                 };
-                let ty = |s: &str| {
-                    Ty::parse(s).ok_or_else(|| err(line_no, format!("unknown PLY type '{s}'")))
-                };
+                let ty = |s: &str| Ty::parse(s).ok_or_else(|| err(line_no, format!("unknown PLY type '{s}'")));
                 let prop = match words.as_slice() {
-                    ["property", "list", c, i, name] => Prop { name: name.to_string(), kind: Kind::List(ty(c)?, ty(i)?) },
+                    ["property", "list", c, i, name] => {
+                        Prop { name: name.to_string(), kind: Kind::List(ty(c)?, ty(i)?) }
+                    }
                     ["property", t, name] => Prop { name: name.to_string(), kind: Kind::Scalar(ty(t)?) },
-                    _ => return Err(err(line_no, "expected 'property <type> <name>' or 'property list <count type> <type> <name>'".into())),
+                    _ => {
+                        return Err(err(
+                            line_no,
+                            "expected 'property <type> <name>' or 'property list <count type> <type> <name>'".into(),
+                        ));
+                    }
                 };
                 el.props.push(prop);
             }
             Some("end_header") => break,
             Some(other) => {
-                return Err(err(
-                    line_no,
-                    format!("unknown PLY header keyword '{other}'"),
-                ));
+                return Err(err(line_no, format!("unknown PLY header keyword '{other}'")));
             }
         }
     }
@@ -250,12 +214,8 @@ fn read_ascii(
     out: &mut PlyData,
     path: &Path,
 ) -> Result<()> {
-    let text = std::str::from_utf8(body)
-        .map_err(|_| Error::mesh(path, "PLY body is not text (format says ascii)"))?;
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + header_lines + 1, l));
+    let text = std::str::from_utf8(body).map_err(|_| Error::mesh(path, "PLY body is not text (format says ascii)"))?;
+    let mut lines = text.lines().enumerate().map(|(i, l)| (i + header_lines + 1, l));
     let mut last_line = header_lines;
     let mut vals: Vec<f64> = Vec::new();
     let mut poly: Vec<i64> = Vec::new();
@@ -283,15 +243,10 @@ fn read_ascii(
             let err = |msg: String| Error::mesh(path, format!("line {ln}: {msg}"));
             let mut tok = line.split_ascii_whitespace();
             let mut next_num = |what: &dyn Fn() -> String| -> Result<f64> {
-                let s = tok.next().ok_or_else(|| {
-                    err(format!(
-                        "expected {} of element '{}', found end of line",
-                        what(),
-                        el.name
-                    ))
-                })?;
-                s.parse::<f64>()
-                    .map_err(|_| err(format!("expected a number for {}, found '{s}'", what())))
+                let s = tok
+                    .next()
+                    .ok_or_else(|| err(format!("expected {} of element '{}', found end of line", what(), el.name)))?;
+                s.parse::<f64>().map_err(|_| err(format!("expected a number for {}, found '{s}'", what())))
             };
             vals.clear();
             poly.clear();
@@ -305,9 +260,7 @@ fn read_ascii(
                         }
                         let n = n as usize;
                         for k in 0..n {
-                            let v = next_num(&|| {
-                                format!("vertex index {} of {n} in list '{}'", k + 1, p.name)
-                            })?;
+                            let v = next_num(&|| format!("vertex index {} of {n} in list '{}'", k + 1, p.name))?;
                             if ei == fi && pi == layout.face_list {
                                 if v.fract() != 0.0 {
                                     return Err(err(format!("vertex index {v} is not an integer")));
@@ -338,36 +291,24 @@ fn read_ascii(
 
 fn push_vertex(out: &mut PlyData, layout: &Layout, val: impl Fn(usize) -> f64) {
     let [x, y, z] = layout.xyz;
-    out.positions
-        .push(Vec3::new(val(x) as f32, val(y) as f32, val(z) as f32));
+    out.positions.push(Vec3::new(val(x) as f32, val(y) as f32, val(z) as f32));
     if let (Some(ns), Some([a, b, c])) = (out.normals.as_mut(), layout.normal) {
         ns.push(Vec3::new(val(a) as f32, val(b) as f32, val(c) as f32));
     }
 }
 
 /// Fan-triangulates one polygon after checking its indices.
-fn push_polygon(
-    out: &mut PlyData,
-    poly: &[i64],
-    n_vertices: usize,
-    err: impl Fn(String) -> Error,
-) -> Result<()> {
+fn push_polygon(out: &mut PlyData, poly: &[i64], n_vertices: usize, err: impl Fn(String) -> Error) -> Result<()> {
     if poly.len() < 3 {
-        return Err(err(format!(
-            "expected at least 3 vertex indices, found {}",
-            poly.len()
-        )));
+        return Err(err(format!("expected at least 3 vertex indices, found {}", poly.len())));
     }
     for &i in poly {
         if i < 0 || i as usize >= n_vertices {
-            return Err(err(format!(
-                "vertex index {i} out of range (the file has {n_vertices} vertices)"
-            )));
+            return Err(err(format!("vertex index {i} out of range (the file has {n_vertices} vertices)")));
         }
     }
     for k in 1..poly.len() - 1 {
-        out.triangles
-            .push([poly[0] as u32, poly[k] as u32, poly[k + 1] as u32]);
+        out.triangles.push([poly[0] as u32, poly[k] as u32, poly[k + 1] as u32]);
     }
     Ok(())
 }
@@ -414,21 +355,13 @@ fn read_binary(
     out: &mut PlyData,
     path: &Path,
 ) -> Result<()> {
-    let mut cur = Cursor {
-        data: body,
-        pos: 0,
-        big: format == Format::BigEndian,
-    };
+    let mut cur = Cursor { data: body, pos: 0, big: format == Format::BigEndian };
     let mut vals: Vec<f64> = Vec::new();
     let mut poly: Vec<i64> = Vec::new();
     for (ei, el) in elements.iter().enumerate() {
         for instance in 0..el.count {
-            let err = |msg: String| {
-                Error::mesh(
-                    path,
-                    format!("element '{}' #{instance} (of {}): {msg}", el.name, el.count),
-                )
-            };
+            let err =
+                |msg: String| Error::mesh(path, format!("element '{}' #{instance} (of {}): {msg}", el.name, el.count));
             let eof = || err("unexpected end of file (truncated?)".into());
             vals.clear();
             poly.clear();

@@ -19,11 +19,7 @@ pub struct Quad {
 impl Quad {
     /// A quad from a corner and its two edges.
     pub fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Quad {
-        Quad {
-            origin,
-            edge_u,
-            edge_v,
-        }
+        Quad { origin, edge_u, edge_v }
     }
 
     /// Unit normal `normalize(edge_u x edge_v)`.
@@ -58,11 +54,7 @@ impl Quad {
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let (t, a, b, n) = self.hit_coords(ray, t_max)?;
-        Some(Hit::flat(
-            t,
-            self.origin + self.edge_u * a + self.edge_v * b,
-            n,
-        ))
+        Some(Hit::flat(t, self.origin + self.edge_u * a + self.edge_v * b, n))
     }
 
     /// True if the ray hits the quad with `0 < t < t_max`.
@@ -87,16 +79,10 @@ mod tests {
 
     #[test]
     fn corners_in_and_out() {
-        let q = Quad::new(
-            Vec3::ZERO,
-            Vec3::new(2.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-        );
+        let q = Quad::new(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
         assert_eq!(q.normal(), Vec3::Z);
         let down = -Vec3::Z;
-        let h = q
-            .intersect(&Ray::new(Vec3::new(1.0, 0.5, 3.0), down), f32::INFINITY)
-            .unwrap();
+        let h = q.intersect(&Ray::new(Vec3::new(1.0, 0.5, 3.0), down), f32::INFINITY).unwrap();
         assert!((h.t - 3.0).abs() < 1e-6 && h.n == Vec3::Z && h.p == Vec3::new(1.0, 0.5, 0.0));
         assert!(q.occluded(&Ray::new(Vec3::new(1.999, 0.999, 3.0), down), f32::INFINITY));
         assert!(q.occluded(&Ray::new(Vec3::new(0.001, 0.001, 3.0), down), f32::INFINITY));
@@ -113,12 +99,9 @@ mod tests {
     #[test]
     fn spawned_rays_do_not_rehit_at_any_scale() {
         let mut rng = Pcg32::new(11, 3);
-        for (scale, offset) in [
-            (1e-4f32, Vec3::ZERO),
-            (1.0, Vec3::ZERO),
-            (1e4, Vec3::ZERO),
-            (1.0, Vec3::new(1e4, 0.0, 0.0)),
-        ] {
+        for (scale, offset) in
+            [(1e-4f32, Vec3::ZERO), (1.0, Vec3::ZERO), (1e4, Vec3::ZERO), (1.0, Vec3::new(1e4, 0.0, 0.0))]
+        {
             let q = Quad::new(
                 offset + Vec3::new(-0.5, 0.2, -0.5) * scale,
                 Vec3::new(1.0, 0.3, 0.0) * scale,
@@ -128,8 +111,7 @@ mod tests {
             for _ in 0..10_000 {
                 let target = q.origin + q.edge_u * uniform(&mut rng) + q.edge_v * uniform(&mut rng);
                 let o = target + random_dir(&mut rng) * 2.0 * scale;
-                let Some(h) = q.intersect(&Ray::new(o, (target - o).normalize()), f32::INFINITY)
-                else {
+                let Some(h) = q.intersect(&Ray::new(o, (target - o).normalize()), f32::INFINITY) else {
                     continue;
                 };
                 if q.occluded(&Ray::spawn(h.p, h.n, random_dir(&mut rng)), f32::INFINITY) {

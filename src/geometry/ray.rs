@@ -98,10 +98,7 @@ impl Ray {
     /// origin offset along ±n to the side `dir` points to, robust against self-intersection.
     #[inline]
     pub fn spawn(p: Vec3, n: Vec3, dir: Vec3) -> Ray {
-        Ray {
-            origin: offset_ray_origin(p, n, dir),
-            dir,
-        }
+        Ray { origin: offset_ray_origin(p, n, dir), dir }
     }
 
     /// A shadow ray from surface point `p` (normal `n`) towards point `target`; returns
@@ -117,13 +114,7 @@ impl Ray {
             return (Ray { origin, dir: n }, 0.0);
         }
         let t_max = dist * (1.0 - SHADOW_EPSILON) - 2.0 * point_error(target);
-        (
-            Ray {
-                origin,
-                dir: d / dist,
-            },
-            t_max.max(0.0),
-        )
+        (Ray { origin, dir: d / dist }, t_max.max(0.0))
     }
 }
 
@@ -154,9 +145,6 @@ mod tests {
         assert!(t < 5.0 && t > 4.99);
         let (_, t0) = Ray::spawn_to(Vec3::ONE, Vec3::Y, Vec3::ONE);
         assert!((0.0..1e-4).contains(&t0));
-        assert_eq!(
-            Ray::new(Vec3::ZERO, Vec3::X).at(2.0),
-            Vec3::new(2.0, 0.0, 0.0)
-        );
+        assert_eq!(Ray::new(Vec3::ZERO, Vec3::X).at(2.0), Vec3::new(2.0, 0.0, 0.0));
     }
 }

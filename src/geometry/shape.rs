@@ -77,15 +77,8 @@ mod tests {
             Shape::Bubble(Bubble::new(Vec3::new(0.0, 0.0, 5.0), 1.0, 0.5)),
             Shape::Plane(Plane::new(Vec3::new(0.0, 0.0, 4.0), Vec3::Z)),
             Shape::Disk(Disk::new(Vec3::new(0.0, 0.0, 4.0), Vec3::Z, 1.0)),
-            Shape::Cuboid(Cuboid::new(
-                Vec3::new(-1.0, -1.0, 4.0),
-                Vec3::new(1.0, 1.0, 6.0),
-            )),
-            Shape::Quad(Quad::new(
-                Vec3::new(-1.0, -1.0, 4.0),
-                Vec3::X * 2.0,
-                Vec3::Y * 2.0,
-            )),
+            Shape::Cuboid(Cuboid::new(Vec3::new(-1.0, -1.0, 4.0), Vec3::new(1.0, 1.0, 6.0))),
+            Shape::Quad(Quad::new(Vec3::new(-1.0, -1.0, 4.0), Vec3::X * 2.0, Vec3::Y * 2.0)),
         ];
         let r = Ray::new(Vec3::ZERO, Vec3::Z);
         for s in &shapes {

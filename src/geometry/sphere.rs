@@ -81,9 +81,7 @@ impl Sphere {
     /// True if the ray hits the sphere with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        sphere_roots(self.center, self.radius, ray)
-            .and_then(|r| first_root(r, t_max))
-            .is_some()
+        sphere_roots(self.center, self.radius, ray).and_then(|r| first_root(r, t_max)).is_some()
     }
 
     /// Bounding box.
@@ -115,29 +113,19 @@ pub(crate) mod tests {
     #[test]
     fn axis_ray_hits_at_d_minus_r() {
         let s = Sphere::new(Vec3::new(0.0, 0.0, 10.0), 2.0);
-        let h = s
-            .intersect(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY)
-            .unwrap();
+        let h = s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), f32::INFINITY).unwrap();
         assert!((h.t - 8.0).abs() < 1e-5);
         assert!((h.n - -Vec3::Z).length() < 1e-6);
         assert_eq!(h.ns, h.n);
         // From the centre: hits the far side with the outward normal.
-        let h = s
-            .intersect(&Ray::new(s.center, Vec3::X), f32::INFINITY)
-            .unwrap();
+        let h = s.intersect(&Ray::new(s.center, Vec3::X), f32::INFINITY).unwrap();
         assert!((h.t - 2.0).abs() < 1e-6 && (h.n - Vec3::X).length() < 1e-6);
         // t_max cuts it off; behind the ray misses.
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), 7.9).is_none());
-        assert!(
-            s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), f32::INFINITY)
-                .is_none()
-        );
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), f32::INFINITY).is_none());
         assert!(!s.occluded(&Ray::new(Vec3::ZERO, -Vec3::Z), f32::INFINITY));
         assert!(s.occluded(&Ray::new(Vec3::ZERO, Vec3::Z), 9.0));
-        assert_eq!(
-            s.bounds(),
-            Aabb::new(Vec3::new(-2.0, -2.0, 8.0), Vec3::new(2.0, 2.0, 12.0))
-        );
+        assert_eq!(s.bounds(), Aabb::new(Vec3::new(-2.0, -2.0, 8.0), Vec3::new(2.0, 2.0, 12.0)));
     }
 
     #[test]
@@ -147,19 +135,8 @@ pub(crate) mod tests {
         if let Some(h) = h {
             assert!((h.t - 5.0).abs() < 1e-2 && h.n.is_finite() && (h.n - Vec3::Y).length() < 1e-2);
         }
-        assert!(
-            s.intersect(
-                &Ray::new(Vec3::new(-5.0, 1.0001, 0.0), Vec3::X),
-                f32::INFINITY
-            )
-            .is_none()
-        );
-        let h = s
-            .intersect(
-                &Ray::new(Vec3::new(-5.0, 0.9999, 0.0), Vec3::X),
-                f32::INFINITY,
-            )
-            .unwrap();
+        assert!(s.intersect(&Ray::new(Vec3::new(-5.0, 1.0001, 0.0), Vec3::X), f32::INFINITY).is_none());
+        let h = s.intersect(&Ray::new(Vec3::new(-5.0, 0.9999, 0.0), Vec3::X), f32::INFINITY).unwrap();
         assert!(h.n.is_finite() && (h.p.length() - 1.0).abs() < 1e-6);
     }
 

@@ -50,27 +50,13 @@ impl TriRay {
             std::mem::swap(&mut kx, &mut ky);
         }
         let dz = ray.dir[kz];
-        TriRay {
-            origin: ray.origin,
-            kx,
-            ky,
-            kz,
-            sx: ray.dir[kx] / dz,
-            sy: ray.dir[ky] / dz,
-            sz: 1.0 / dz,
-        }
+        TriRay { origin: ray.origin, kx, ky, kz, sx: ray.dir[kx] / dz, sy: ray.dir[ky] / dz, sz: 1.0 / dz }
     }
 
     /// Watertight test against triangle `(p0, p1, p2)`: `Some((t, b0, b1, b2))` for a hit
     /// with `0 < t < t_max`, where `b` are the barycentric weights of the three vertices.
     #[inline(always)]
-    pub fn intersect(
-        &self,
-        p0: Vec3,
-        p1: Vec3,
-        p2: Vec3,
-        t_max: f32,
-    ) -> Option<(f32, f32, f32, f32)> {
+    pub fn intersect(&self, p0: Vec3, p1: Vec3, p2: Vec3, t_max: f32) -> Option<(f32, f32, f32, f32)> {
         let a = p0 - self.origin;
         let b = p1 - self.origin;
         let c = p2 - self.origin;
@@ -86,9 +72,7 @@ impl TriRay {
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
         if u == 0.0 || v == 0.0 || w == 0.0 {
-            let (ax, ay, bx, by, cx, cy) = (
-                ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
-            );
+            let (ax, ay, bx, by, cx, cy) = (ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64);
             u = (cx * by - cy * bx) as f32;
             v = (ax * cy - ay * cx) as f32;
             w = (bx * ay - by * ax) as f32;
@@ -127,9 +111,7 @@ impl Triangle {
     /// Unit geometric normal (zero for a degenerate triangle).
     #[inline]
     pub fn normal(&self) -> Vec3 {
-        (self.v1 - self.v0)
-            .cross(self.v2 - self.v0)
-            .normalize_or_zero()
+        (self.v1 - self.v0).cross(self.v2 - self.v0).normalize_or_zero()
     }
 
     /// Area.
@@ -148,9 +130,7 @@ impl Triangle {
     /// True if the ray hits the triangle with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        TriRay::new(ray)
-            .intersect(self.v0, self.v1, self.v2, t_max)
-            .is_some()
+        TriRay::new(ray).intersect(self.v0, self.v1, self.v2, t_max).is_some()
     }
 
     /// Bounding box.
@@ -169,40 +149,17 @@ mod tests {
     fn closed_form_hit_and_normal() {
         let tri = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
         assert_eq!(tri.normal(), Vec3::Z);
-        let h = tri
-            .intersect(
-                &Ray::new(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z),
-                f32::INFINITY,
-            )
-            .unwrap();
+        let h = tri.intersect(&Ray::new(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z), f32::INFINITY).unwrap();
         assert!((h.t - 2.0).abs() < 1e-6 && h.n == Vec3::Z);
         assert!((h.p - Vec3::new(0.25, 0.25, 0.0)).length() < 1e-7);
         // From behind: same normal.
-        assert!(
-            tri.intersect(
-                &Ray::new(Vec3::new(0.25, 0.25, -2.0), Vec3::Z),
-                f32::INFINITY
-            )
-            .is_some()
-        );
-        assert!(
-            tri.intersect(&Ray::new(Vec3::new(0.6, 0.6, 2.0), -Vec3::Z), f32::INFINITY)
-                .is_none()
-        );
+        assert!(tri.intersect(&Ray::new(Vec3::new(0.25, 0.25, -2.0), Vec3::Z), f32::INFINITY).is_some());
+        assert!(tri.intersect(&Ray::new(Vec3::new(0.6, 0.6, 2.0), -Vec3::Z), f32::INFINITY).is_none());
         assert!(!tri.occluded(&Ray::new(Vec3::new(0.25, 0.25, 2.0), -Vec3::Z), 1.5));
         // Parallel ray in the plane and a degenerate triangle: no hit, no NaN.
-        assert!(
-            tri.intersect(
-                &Ray::new(Vec3::new(-1.0, 0.25, 0.0), Vec3::X),
-                f32::INFINITY
-            )
-            .is_none()
-        );
+        assert!(tri.intersect(&Ray::new(Vec3::new(-1.0, 0.25, 0.0), Vec3::X), f32::INFINITY).is_none());
         let deg = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
-        assert!(
-            deg.intersect(&Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z), f32::INFINITY)
-                .is_none()
-        );
+        assert!(deg.intersect(&Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z), f32::INFINITY).is_none());
     }
 
     #[test]
@@ -217,26 +174,17 @@ mod tests {
                 c + Vec3::new(a.cos(), a.sin(), 0.3 * a.cos() - 0.2 * a.sin())
             })
             .collect();
-        let tris: Vec<Triangle> = (0..7)
-            .map(|i| Triangle::new(c, ring[i], ring[(i + 1) % 7]))
-            .collect();
+        let tris: Vec<Triangle> = (0..7).map(|i| Triangle::new(c, ring[i], ring[(i + 1) % 7])).collect();
         for _ in 0..20_000 {
             let i = (uniform(&mut rng) * 7.0) as usize % 7;
             let s = uniform(&mut rng);
-            let target = if uniform(&mut rng) < 0.1 {
-                c
-            } else {
-                c + (ring[i] - c) * s
-            };
+            let target = if uniform(&mut rng) < 0.1 { c } else { c + (ring[i] - c) * s };
             let mut o = target + random_dir(&mut rng) * 3.0;
             if (o - target).z.abs() < 0.1 {
                 o.z += 1.0;
             }
             let r = Ray::new(o, (target - o).normalize());
-            assert!(
-                tris.iter().any(|t| t.occluded(&r, f32::INFINITY)),
-                "leak at {target:?} from {o:?}"
-            );
+            assert!(tris.iter().any(|t| t.occluded(&r, f32::INFINITY)), "leak at {target:?} from {o:?}");
         }
     }
 
@@ -251,15 +199,10 @@ mod tests {
             );
             for _ in 0..5000 {
                 let (a, b) = (uniform(&mut rng), uniform(&mut rng));
-                let (a, b) = if a + b > 1.0 {
-                    (1.0 - a, 1.0 - b)
-                } else {
-                    (a, b)
-                };
+                let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
                 let target = tri.v0 + (tri.v1 - tri.v0) * a + (tri.v2 - tri.v0) * b;
                 let o = target + random_dir(&mut rng) * scale;
-                let Some(h) = tri.intersect(&Ray::new(o, (target - o).normalize()), f32::INFINITY)
-                else {
+                let Some(h) = tri.intersect(&Ray::new(o, (target - o).normalize()), f32::INFINITY) else {
                     continue;
                 };
                 assert!(!tri.occluded(&Ray::spawn(h.p, h.n, random_dir(&mut rng)), f32::INFINITY));

@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::desc::{IorDesc, LightDesc, MaterialDesc, RenderDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
 use super::{Object, Scene, Settings};
-use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, OrenNayar, named_glass, NAMED_GLASSES};
+use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, OrenNayar, named_glass};
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
@@ -57,7 +57,11 @@ impl Ctx<'_> {
     }
 
     fn positive(&self, field: &str, v: f32) -> Result<f32> {
-        if v.is_finite() && v > 0.0 { Ok(v) } else { Err(self.err(field, format!("expected a positive number, found {v}"))) }
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("expected a positive number, found {v}")))
+        }
     }
 
     fn vec(&self, field: &str, v: V3) -> Result<Vec3> {
@@ -75,12 +79,20 @@ impl Ctx<'_> {
             SpectrumDesc::Constant(v) => Spectrum::splat(*v),
             SpectrumDesc::Samples(v) => {
                 if v.len() != N_BINS {
-                    return Err(self.err(field, format!("expected 36 samples (380 to 730 nm every 10 nm), found {}", v.len())));
+                    return Err(
+                        self.err(field, format!("expected 36 samples (380 to 730 nm every 10 nm), found {}", v.len()))
+                    );
                 }
                 Spectrum::from_fn(|i| v[i])
             }
             SpectrumDesc::ColorChecker(name) => color::named::color_checker(name).ok_or_else(|| {
-                self.err(field, format!("unknown ColorChecker patch \"{name}\"; expected one of: {}", color::named::COLOR_CHECKER_NAMES.join(", ")))
+                self.err(
+                    field,
+                    format!(
+                        "unknown ColorChecker patch \"{name}\"; expected one of: {}",
+                        color::named::COLOR_CHECKER_NAMES.join(", ")
+                    ),
+                )
             })?,
             SpectrumDesc::D65 => color::named::d65(),
             SpectrumDesc::EqualEnergy => color::named::equal_energy(),
@@ -115,7 +127,8 @@ impl Ctx<'_> {
         for lambda in [color::LAMBDA_MIN_NM, 550.0, color::bin_lambda_nm(N_BINS - 1)] {
             let n = ior.at(lambda);
             if !(n.is_finite() && n > 0.0) {
-                return Err(self.err(field, format!("the index of refraction at {lambda} nm is {n}; expected a positive number")));
+                return Err(self
+                    .err(field, format!("the index of refraction at {lambda} nm is {n}; expected a positive number")));
             }
         }
         Ok(ior)
@@ -123,19 +136,25 @@ impl Ctx<'_> {
 
     fn material(&self, field: &str, d: &MaterialDesc) -> Result<Bxdf> {
         Ok(match d {
-            MaterialDesc::Lambertian { reflectance } => {
-                Bxdf::Lambertian(Lambertian { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
-            }
+            MaterialDesc::Lambertian { reflectance } => Bxdf::Lambertian(Lambertian {
+                reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)?,
+            }),
             MaterialDesc::OrenNayar { reflectance, sigma_deg } => {
                 if !(sigma_deg.is_finite() && (0.0..=90.0).contains(sigma_deg)) {
-                    return Err(self.err(format!("{field}.sigma_deg"), format!("expected degrees in [0, 90], found {sigma_deg}")));
+                    return Err(self
+                        .err(format!("{field}.sigma_deg"), format!("expected degrees in [0, 90], found {sigma_deg}")));
                 }
-                Bxdf::OrenNayar(OrenNayar::new(self.reflectance(&format!("{field}.reflectance"), reflectance)?, *sigma_deg))
+                Bxdf::OrenNayar(OrenNayar::new(
+                    self.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                    *sigma_deg,
+                ))
             }
             MaterialDesc::Mirror { reflectance } => {
                 Bxdf::Mirror(Mirror { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
             }
-            MaterialDesc::Dielectric { ior } => Bxdf::Dielectric(Dielectric { ior: self.ior(&format!("{field}.ior"), ior)? }),
+            MaterialDesc::Dielectric { ior } => {
+                Bxdf::Dielectric(Dielectric { ior: self.ior(&format!("{field}.ior"), ior)? })
+            }
             MaterialDesc::Black => Bxdf::Black,
         })
     }
@@ -150,13 +169,19 @@ impl Ctx<'_> {
                 let outer = self.positive(&f("outer_radius"), *outer_radius)?;
                 let inner = self.positive(&f("inner_radius"), *inner_radius)?;
                 if inner >= outer {
-                    return Err(self.err(f("inner_radius"), format!("expected less than outer_radius ({outer}), found {inner}")));
+                    return Err(self
+                        .err(f("inner_radius"), format!("expected less than outer_radius ({outer}), found {inner}")));
                 }
-                Shape::Bubble(Bubble { center: self.vec(&f("center"), *center)?, outer_radius: outer, inner_radius: inner })
+                Shape::Bubble(Bubble {
+                    center: self.vec(&f("center"), *center)?,
+                    outer_radius: outer,
+                    inner_radius: inner,
+                })
             }
-            ShapeDesc::Plane { point, normal } => {
-                Shape::Plane(Plane { point: self.vec(&f("point"), *point)?, normal: self.direction(&f("normal"), *normal)? })
-            }
+            ShapeDesc::Plane { point, normal } => Shape::Plane(Plane {
+                point: self.vec(&f("point"), *point)?,
+                normal: self.direction(&f("normal"), *normal)?,
+            }),
             ShapeDesc::Disk { center, normal, radius } => Shape::Disk(Disk {
                 center: self.vec(&f("center"), *center)?,
                 normal: self.direction(&f("normal"), *normal)?,
@@ -219,7 +244,10 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &RenderDesc, content_hash: u
         let material = match &o.material {
             Some(name) => *by_name.get(name.as_str()).ok_or_else(|| {
                 let known: Vec<&str> = by_name.keys().copied().collect();
-                ctx.err(format!("{field}.material"), format!("unknown material \"{name}\"; defined: {}", known.join(", ")))
+                ctx.err(
+                    format!("{field}.material"),
+                    format!("unknown material \"{name}\"; defined: {}", known.join(", ")),
+                )
             })?,
             None if o.emission.is_some() => 0,
             None => return Err(ctx.err(&field, "expected a `material` or an `emission`")),
@@ -255,7 +283,8 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &RenderDesc, content_hash: u
     let eye = ctx.vec("camera.eye", c.eye)?;
     let look_at = ctx.vec("camera.look_at", c.look_at)?;
     let up = ctx.direction("camera.up", c.up)?;
-    let forward = (look_at - eye).try_normalize().ok_or_else(|| ctx.err("camera.look_at", "must differ from camera.eye"))?;
+    let forward =
+        (look_at - eye).try_normalize().ok_or_else(|| ctx.err("camera.look_at", "must differ from camera.eye"))?;
     if forward.cross(up).length() < 1e-4 {
         return Err(ctx.err("camera.up", "must not be parallel to the view direction"));
     }

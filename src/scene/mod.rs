@@ -148,7 +148,19 @@ impl Scene {
                 acc
             })
             .collect();
-        Scene { objects, materials, lights, light_pmf, light_cdf, camera, settings, bounded, unbounded, bvh, content_hash }
+        Scene {
+            objects,
+            materials,
+            lights,
+            light_pmf,
+            light_cdf,
+            camera,
+            settings,
+            bounded,
+            unbounded,
+            bvh,
+            content_hash,
+        }
     }
 
     /// The closest hit along `ray` before `t_max`.
@@ -189,7 +201,9 @@ impl Scene {
             return true;
         }
         match &self.bvh {
-            Some(bvh) => bvh.occluded(ray, t_max, |k, t| self.objects[self.bounded[k as usize] as usize].shape.occluded(ray, t)),
+            Some(bvh) => {
+                bvh.occluded(ray, t_max, |k, t| self.objects[self.bounded[k as usize] as usize].shape.occluded(ray, t))
+            }
             None => self.bounded.iter().any(|&i| self.objects[i as usize].shape.occluded(ray, t_max)),
         }
     }
