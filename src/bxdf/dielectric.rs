@@ -79,4 +79,24 @@ mod tests {
             }
         }
     }
+
+    /// Snell's law per wavelength with a dispersive glass: η_i sin θ_i =
+    /// η_t(λ) sin θ_t for the index the Sellmeier equation gives at λ, and
+    /// violet bends more than red.
+    #[test]
+    fn snell_per_wavelength() {
+        let ior = crate::bxdf::named_glass("N-BK7").unwrap();
+        let d = Dielectric { ior: ior.clone() };
+        let theta = 50f32.to_radians();
+        let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+        let mut last_sin_t = 0.0;
+        for lambda in [400.0, 550.0, 700.0] {
+            let n = ior.at(lambda);
+            let t: BsdfSample<1> = d.sample(wo, 0.999_999, n).unwrap();
+            let sin_t = (t.wi.x * t.wi.x + t.wi.y * t.wi.y).sqrt();
+            assert!((theta.sin() - n * sin_t).abs() < 1e-5, "{lambda} nm");
+            assert!(sin_t > last_sin_t, "longer wavelengths bend less");
+            last_sin_t = sin_t;
+        }
+    }
 }

@@ -1,0 +1,231 @@
+//! Dispersion and the integrators (issue 3): the prism against Snell's law,
+//! the invisible glass sphere, and unbiasedness of every wavelength sampler.
+
+use rust_v::film::Film;
+use rust_v::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
+
+use crate::common::{mean_and_stderr, render_str, root};
+
+/// Film columns at which scripts/prism_geometry.py (an independent 2-D f64
+/// tracer with the N-SF11 Sellmeier equation) predicts each wavelength's image
+/// of the light in scenes/prism.ron.
+const PRISM_COLUMNS: [(usize, f64); 7] =
+    [(400, 387.11), (450, 266.33), (500, 192.81), (550, 143.48), (600, 108.22), (650, 81.85), (700, 61.41)];
+
+fn overrides(integrator: IntegratorKind, wavelengths: WavelengthsKind, spp: u32, seed: u64) -> RenderDesc {
+    RenderDesc {
+        integrator: Some(integrator),
+        wavelengths: Some(wavelengths),
+        spp: Some(spp),
+        seed: Some(seed),
+        ..Default::default()
+    }
+}
+
+/// The light emits in one 10 nm bin only; the centroid of the image must sit
+/// at the predicted column within 1.5 px (the light's image is ~2 px wide and
+/// the bin centre wavelength is exact), and shorter wavelengths deviate more
+/// (appear further right).
+#[test]
+fn prism_images_sit_where_snell_puts_them() {
+    let text = std::fs::read_to_string(root().join("scenes/prism.ron")).unwrap();
+    let mut last = f64::INFINITY;
+    for (lambda, want) in PRISM_COLUMNS {
+        let bin = (lambda - 380) / 10;
+        let samples: Vec<String> = (0..36).map(|i| if i == bin { "1000".into() } else { "0".into() }).collect();
+        let scene = text
+            .replace("Scaled(50, EqualEnergy)", &format!("Samples([{}])", samples.join(", ")))
+            .replace("\"../meshes/prism.obj\"", &format!("\"{}\"", root().join("meshes/prism.obj").display()));
+        let film = render_str(&scene, &overrides(IntegratorKind::Spectral, WavelengthsKind::Hero, 16, 1));
+        let (col, total) = centroid_column(&film);
+        assert!(total > 0.0, "{lambda} nm: no image of the light");
+        assert!((col - want).abs() < 1.5, "{lambda} nm: image at column {col:.2}, Snell says {want:.2}");
+        assert!(col < last, "{lambda} nm is not left of the shorter wavelengths");
+        last = col;
+    }
+}
+
+/// Brightness-weighted mean column (X + Y + Z as the weight) within 4 px of
+/// the brightest column: the main image. Light reflected inside the prism
+/// also reaches the camera (ghost images a few percent as bright, real
+/// physics), and must not pull the centroid.
+fn centroid_column(film: &Film) -> (f64, f64) {
+    let w = film.width() as usize;
+    let mut columns = vec![0.0; w];
+    for (i, p) in film.mean_xyz().iter().enumerate() {
+        columns[i % w] += p[0] + p[1] + p[2];
+    }
+    let peak = (0..w).max_by(|&a, &b| columns[a].total_cmp(&columns[b])).unwrap_or(0);
+    let (mut sum, mut total) = (0.0, 0.0);
+    for (x, &c) in columns.iter().enumerate().take((peak + 5).min(w)).skip(peak.saturating_sub(4)) {
+        sum += c * (x as f64 + 0.5);
+        total += c;
+    }
+    (sum / total, total)
+}
+
+/// A dispersive (N-BK7) glass sphere inside a uniformly emitting enclosure is
+/// invisible: every path that escapes sees L_e = 1, and the refraction
+/// weights cancel (1/η² in, η² out). For `path` and `whitted` every sample of
+/// a pixel is 1 unless roulette or the bounce limit intervene, so each pixel
+/// is within 3%; the packet samplers add colour noise with mean 1, checked
+/// on the image mean with 5 standard errors.
+#[test]
+fn glass_sphere_in_a_furnace_is_invisible() {
+    let scene = r#"(
+        camera: (eye: (0, 0, 4), look_at: (0, 0, 0), fov_deg: 30),
+        render: (width: 16, height: 16, max_bounces: 64),
+        materials: { "glass": Dielectric(ior: Named("N-BK7")) },
+        objects: [
+            (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"),
+            (shape: Sphere(center: (0, 0, 0), radius: 10), emission: Constant(1), two_sided: true),
+        ],
+    )"#;
+    for (integrator, wl) in [
+        (IntegratorKind::Path, WavelengthsKind::Hero),
+        (IntegratorKind::Whitted, WavelengthsKind::Hero),
+        (IntegratorKind::Spectral, WavelengthsKind::Hero),
+        (IntegratorKind::Spectral, WavelengthsKind::Random),
+    ] {
+        let film = render_str(scene, &overrides(integrator, wl, 64, 3));
+        let (mean, se) = mean_and_stderr(&film, 1);
+        assert!((mean - 1.0).abs() < 5.0 * se + 2e-3, "{integrator:?}/{wl:?}: Y = {mean} ± {se}");
+        if integrator != IntegratorKind::Spectral {
+            for p in film.mean_xyz() {
+                assert!((p[1] - 1.0).abs() < 0.03, "{integrator:?}: pixel Y = {}", p[1]);
+            }
+        }
+    }
+}
+
+/// Per-block means over `seeds` independent renders: block values and their
+/// standard errors from the seed-to-seed spread.
+fn block_stats(scene: &str, o: impl Fn(u64) -> RenderDesc, seeds: u64, block: usize) -> Vec<(f64, f64)> {
+    let films: Vec<Film> = (0..seeds).map(|s| render_str(scene, &o(s))).collect();
+    let (w, h) = (films[0].width() as usize, films[0].height() as usize);
+    let mut out = Vec::new();
+    for by in (0..h).step_by(block) {
+        for bx in (0..w).step_by(block) {
+            for c in 0..3 {
+                let vals: Vec<f64> = films
+                    .iter()
+                    .map(|f| {
+                        let m = f.mean_xyz();
+                        let mut s = 0.0;
+                        for y in by..by + block {
+                            for x in bx..bx + block {
+                                s += m[y * w + x][c];
+                            }
+                        }
+                        s / (block * block) as f64
+                    })
+                    .collect();
+                let n = vals.len() as f64;
+                let mean = vals.iter().sum::<f64>() / n;
+                let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+                out.push((mean, (var / n).sqrt()));
+            }
+        }
+    }
+    out
+}
+
+/// Two estimators converge to the same image: every block (4x4 pixels, each
+/// channel) agrees within z < 5 using standard errors measured from 8 seeds.
+/// With 48 comparisons, a false alarm at 5 sigma has probability < 1e-4
+/// under a normal approximation (Student t with 7 d.o.f. is heavier-tailed,
+/// which the 5 sigma also covers at about 0.2% per comparison... so the
+/// bound uses 6 sigma: p < 0.1% per comparison, < 5% over all 48).
+fn assert_same_image(a: &[(f64, f64)], b: &[(f64, f64)], what: &str) {
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        let se = (x.1 * x.1 + y.1 * y.1).sqrt();
+        let z = (x.0 - y.0).abs() / se.max(1e-12);
+        assert!(z < 6.0, "{what}: block {} channel {}: {:.5} vs {:.5} (z = {z:.1})", i / 3, i % 3, x.0, y.0);
+    }
+}
+
+/// Without dispersion, path, hero and random packets estimate the same image.
+#[test]
+fn spectral_samplers_agree_with_path_without_dispersion() {
+    let scene = std::fs::read_to_string(root().join("scenes/cornell-lambert.ron")).unwrap();
+    let o = |integrator, wl| {
+        move |s| RenderDesc { width: Some(16), height: Some(16), ..overrides(integrator, wl, 32, 100 + s) }
+    };
+    let path = block_stats(&scene, o(IntegratorKind::Path, WavelengthsKind::Hero), 8, 4);
+    let hero = block_stats(&scene, o(IntegratorKind::Spectral, WavelengthsKind::Hero), 8, 4);
+    let random = block_stats(&scene, o(IntegratorKind::Spectral, WavelengthsKind::Random), 8, 4);
+    assert_same_image(&path, &hero, "path vs hero");
+    assert_same_image(&path, &random, "path vs random");
+}
+
+/// With dispersion (nine N-SF11 spheres), hero and random packets converge
+/// to the same image.
+#[test]
+fn hero_and_random_agree_with_dispersion() {
+    let scene = std::fs::read_to_string(root().join("scenes/spheres.ron")).unwrap();
+    let o = |wl| {
+        move |s| RenderDesc {
+            width: Some(16),
+            height: Some(16),
+            ..overrides(IntegratorKind::Spectral, wl, 32, 200 + s)
+        }
+    };
+    let hero = block_stats(&scene, o(WavelengthsKind::Hero), 8, 4);
+    let random = block_stats(&scene, o(WavelengthsKind::Random), 8, 4);
+    assert_same_image(&hero, &random, "hero vs random");
+}
+
+/// The thesis saw spectral renders darken at low sample counts (its Figure
+/// 2.5). Here the mean of 64 independent 1-spp hero and random renders equals
+/// the converged brightness (path at 256 spp), within 5 standard errors of
+/// the 1-spp mean (measured from the 64 renders).
+#[test]
+fn one_spp_is_as_bright_as_converged() {
+    let scene = std::fs::read_to_string(root().join("scenes/cornell-lambert.ron")).unwrap();
+    let size = |o: RenderDesc| RenderDesc { width: Some(16), height: Some(16), ..o };
+    let converged = render_str(&scene, &size(overrides(IntegratorKind::Path, WavelengthsKind::Hero, 256, 7)));
+    let (want, want_se) = image_mean_y(&converged);
+    for wl in [WavelengthsKind::Hero, WavelengthsKind::Random] {
+        let means: Vec<f64> = (0..64)
+            .map(|s| image_mean_y(&render_str(&scene, &size(overrides(IntegratorKind::Spectral, wl, 1, 1000 + s)))).0)
+            .collect();
+        let n = means.len() as f64;
+        let mean = means.iter().sum::<f64>() / n;
+        let se = (means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let tol = 5.0 * (se * se + want_se * want_se).sqrt();
+        assert!((mean - want).abs() < tol, "{wl:?}: 1-spp mean Y {mean:.5} vs converged {want:.5} (tol {tol:.5})");
+    }
+}
+
+/// Mean Y of an image with the standard error from the pixel spread (a
+/// conservative error for the image mean: pixels are independent samples).
+fn image_mean_y(film: &Film) -> (f64, f64) {
+    mean_and_stderr(film, 1)
+}
+
+/// On a scene of mirrors and glass only (in an emitting enclosure), Whitted
+/// and path tracing trace the same paths (S* then the emitter), so they agree;
+/// a Whitted that followed both Fresnel lobes without weights would be brighter.
+#[test]
+fn whitted_matches_path_on_specular_only_scenes() {
+    let scene = r#"(
+        camera: (eye: (0, 0, 4), look_at: (0, 0, 0), fov_deg: 40),
+        render: (width: 16, height: 16, max_bounces: 32),
+        materials: {
+            "glass": Dielectric(ior: Constant(1.5)),
+            "mirror": Mirror(reflectance: Constant(0.8)),
+        },
+        objects: [
+            (shape: Sphere(center: (-0.6, 0, 0), radius: 0.5), material: "glass"),
+            (shape: Sphere(center: (0.6, 0, 0), radius: 0.5), material: "mirror"),
+            (shape: Sphere(center: (0, 0, 0), radius: 10), emission: Constant(1), two_sided: true),
+        ],
+    )"#;
+    let w = render_str(scene, &overrides(IntegratorKind::Whitted, WavelengthsKind::Hero, 64, 5));
+    let p = render_str(scene, &overrides(IntegratorKind::Path, WavelengthsKind::Hero, 64, 6));
+    let (mw, sw) = mean_and_stderr(&w, 1);
+    let (mp, sp) = mean_and_stderr(&p, 1);
+    assert!((mw - mp).abs() < 5.0 * (sw * sw + sp * sp).sqrt() + 1e-3, "whitted {mw} vs path {mp}");
+    // The mirror sphere shows 0.8 of the enclosure; it must not be brighter than the glass.
+    assert!(mw < 1.0);
+}
