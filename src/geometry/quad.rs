@@ -5,7 +5,8 @@ use super::plane::plane_t;
 use super::{Aabb, Hit, Ray};
 use glam::Vec3;
 
-/// A parallelogram.
+/// A parallelogram, with the plane and the coordinate projection precomputed
+/// (the intersection test is hot: the Cornell box is made of quads).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quad {
     /// One corner.
@@ -14,18 +15,28 @@ pub struct Quad {
     pub edge_u: Vec3,
     /// Second edge from `origin`.
     pub edge_v: Vec3,
+    /// Unit normal.
+    n: Vec3,
+    /// `n · origin`: the plane offset.
+    d: f32,
+    /// `(u × v) / |u × v|²`: projects a point to the quad coordinates.
+    w: Vec3,
 }
 
 impl Quad {
-    /// A quad from a corner and its two edges.
+    /// A quad from a corner and its two edges (a degenerate quad, with
+    /// parallel or zero edges, is never hit).
     pub fn new(origin: Vec3, edge_u: Vec3, edge_v: Vec3) -> Quad {
-        Quad { origin, edge_u, edge_v }
+        let c = edge_u.cross(edge_v);
+        let len2 = c.length_squared();
+        let (n, w) = if len2 > 0.0 { (c / len2.sqrt(), c / len2) } else { (Vec3::ZERO, Vec3::ZERO) };
+        Quad { origin, edge_u, edge_v, n, d: n.dot(origin), w }
     }
 
     /// Unit normal `normalize(edge_u x edge_v)`.
     #[inline]
     pub fn normal(&self) -> Vec3 {
-        self.edge_u.cross(self.edge_v).normalize_or_zero()
+        self.n
     }
 
     /// Area `|edge_u x edge_v|`.
@@ -36,18 +47,11 @@ impl Quad {
     /// Ray parameter and the quad coordinates `(a, b)` of the hit.
     #[inline]
     fn hit_coords(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32, Vec3)> {
-        let c = self.edge_u.cross(self.edge_v);
-        let len2 = c.length_squared();
-        if !(len2 > 0.0) {
-            return None;
-        }
-        let n = c / len2.sqrt();
-        let t = plane_t(n, n.dot(self.origin), ray, t_max)?;
+        let t = plane_t(self.n, self.d, ray, t_max)?;
         let q = ray.at(t) - self.origin;
-        let w = c / len2;
-        let a = w.dot(q.cross(self.edge_v));
-        let b = w.dot(self.edge_u.cross(q));
-        ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, a, b, n))
+        let a = self.w.dot(q.cross(self.edge_v));
+        let b = self.w.dot(self.edge_u.cross(q));
+        ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, a, b, self.n))
     }
 
     /// Closest hit with `0 < t < t_max`; the point is rebuilt from the quad coordinates.

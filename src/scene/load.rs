@@ -199,7 +199,7 @@ impl Ctx<'_> {
                 if u.cross(v).length_squared() <= f32::MIN_POSITIVE {
                     return Err(self.err(field, "edge_u and edge_v must be non-zero and not parallel"));
                 }
-                Shape::Quad(Quad { origin: self.vec(&f("origin"), *origin)?, edge_u: u, edge_v: v })
+                Shape::Quad(Quad::new(self.vec(&f("origin"), *origin)?, u, v))
             }
             ShapeDesc::Mesh { path, scale, rotate_deg, translate } => {
                 let scale = match scale {

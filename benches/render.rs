@@ -1,0 +1,70 @@
+//! Render throughput: samples per second on the committed scenes at 128x128,
+//! on 1 and 2 threads (median of 3 runs each), and the scaling ratio.
+//!
+//! `cargo bench --bench render [-- SCENE...]`
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use rust_v::film::Film;
+use rust_v::render::{Limits, render};
+use rust_v::scene::desc::{IntegratorKind, RenderDesc};
+use rust_v::scene::load_scene;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
+    let scenes: Vec<String> = if args.is_empty() {
+        ["scenes/cornell.ron", "scenes/cornell-lambert.ron", "scenes/spheres.ron", "scenes/dragon.ron"].map(String::from).to_vec()
+    } else {
+        args
+    };
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    println!("{:<28} {:>10} {:>8} {:>14} {:>14} {:>8}", "scene", "integrator", "passes", "1 thread Ms/s", "2 threads Ms/s", "ratio");
+    for scene_path in scenes {
+        for integrator in [IntegratorKind::Path, IntegratorKind::Spectral] {
+            let overrides = RenderDesc {
+                width: Some(128),
+                height: Some(128),
+                integrator: Some(integrator),
+                ..Default::default()
+            };
+            let scene = match load_scene(&root.join(&scene_path), &overrides) {
+                Ok(s) => s,
+                Err(e) => {
+                    println!("{scene_path}: skipped ({e})");
+                    break;
+                }
+            };
+            let passes = 16;
+            let mut rates = Vec::new();
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
+                let runs: Vec<f64> = (0..3)
+                    .map(|_| {
+                        let mut film = Film::new(128, 128);
+                        let stop = AtomicBool::new(false);
+                        let t = Instant::now();
+                        pool.install(|| render(&scene, &mut film, 0..passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {}));
+                        (passes as f64 * 128.0 * 128.0) / t.elapsed().as_secs_f64() / 1e6
+                    })
+                    .collect();
+                rates.push(median(runs));
+            }
+            println!(
+                "{:<28} {:>10} {:>8} {:>14.3} {:>14.3} {:>8.2}",
+                scene_path,
+                format!("{integrator:?}").to_lowercase(),
+                passes,
+                rates[0],
+                rates[1],
+                rates[1] / rates[0]
+            );
+        }
+    }
+}
