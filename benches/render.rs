@@ -20,20 +20,21 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
     let scenes: Vec<String> = if args.is_empty() {
-        ["scenes/cornell.ron", "scenes/cornell-lambert.ron", "scenes/spheres.ron", "scenes/dragon.ron"].map(String::from).to_vec()
+        ["scenes/cornell.ron", "scenes/cornell-lambert.ron", "scenes/spheres.ron", "scenes/dragon.ron"]
+            .map(String::from)
+            .to_vec()
     } else {
         args
     };
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    println!("{:<28} {:>10} {:>8} {:>14} {:>14} {:>8}", "scene", "integrator", "passes", "1 thread Ms/s", "2 threads Ms/s", "ratio");
+    println!(
+        "{:<28} {:>10} {:>8} {:>14} {:>14} {:>8}",
+        "scene", "integrator", "passes", "1 thread Ms/s", "2 threads Ms/s", "ratio"
+    );
     for scene_path in scenes {
         for integrator in [IntegratorKind::Path, IntegratorKind::Spectral] {
-            let overrides = RenderDesc {
-                width: Some(128),
-                height: Some(128),
-                integrator: Some(integrator),
-                ..Default::default()
-            };
+            let overrides =
+                RenderDesc { width: Some(128), height: Some(128), integrator: Some(integrator), ..Default::default() };
             let scene = match load_scene(&root.join(&scene_path), &overrides) {
                 Ok(s) => s,
                 Err(e) => {
@@ -50,7 +51,15 @@ fn main() {
                         let mut film = Film::new(128, 128);
                         let stop = AtomicBool::new(false);
                         let t = Instant::now();
-                        pool.install(|| render(&scene, &mut film, 0..passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {}));
+                        pool.install(|| {
+                            render(
+                                &scene,
+                                &mut film,
+                                0..passes,
+                                Limits { stop: &stop, time_budget: None },
+                                &mut |_, _| {},
+                            )
+                        });
                         (passes as f64 * 128.0 * 128.0) / t.elapsed().as_secs_f64() / 1e6
                     })
                     .collect();

@@ -124,7 +124,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let s = &scene.settings;
     if !args.quiet {
         eprintln!(
-            "rust-v: {} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {:?} integrator, {} bounces, seed {}",
+            "rust-v: {} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}\nrust-v: {}",
             args.scene.display(),
             scene.object_count(),
             scene.lights.len(),
@@ -132,9 +132,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
             s.width,
             s.height,
             s.spp,
-            s.integrator,
             s.max_bounces,
-            s.seed
+            s.seed,
+            rust_v::integrator::describe(&scene)
         );
     }
     let mut film = Film::new(s.width, s.height);

@@ -257,14 +257,21 @@ pub enum WavelengthSampling {
     Random,
 }
 
+/// Bin `k` of the hero packet of `c` bins whose hero is bin `hero` (thesis
+/// eq. 2.7 on the bin grid): `(hero + k·36/c) mod 36`, rounded down.
+#[inline]
+pub fn hero_bin(hero: usize, k: usize, c: usize) -> usize {
+    (hero + k * N_BINS / c) % N_BINS
+}
+
 /// Draws a packet of `C` bins. `u` supplies `C` uniform numbers in [0, 1)
 /// (hero uses only the first).
 pub fn sample_packet<const C: usize>(how: WavelengthSampling, u: [f32; C]) -> Lambdas<C> {
     let bin = |x: f32| ((x * N_BINS as f32) as usize).min(N_BINS - 1);
     let pos = match how {
         WavelengthSampling::Hero => {
-            let h = bin(u[0]) as f32;
-            std::array::from_fn(|k| (h + (k * N_BINS) as f32 / C as f32).rem_euclid(N_BINS as f32).floor())
+            let h = bin(u[0]);
+            std::array::from_fn(|k| hero_bin(h, k, C) as f32)
         }
         WavelengthSampling::Random => u.map(|x| bin(x) as f32),
     };

@@ -7,6 +7,7 @@
 //! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
 //! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
 //! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface; or `--wavelengths rgb` |
+//! | `auto` (default) | as `path` | the full spectrum until the first dispersive surface, where the path collapses to a hero packet of `C` bins (weight 36/C) that splits as in `spectral`: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
 //! ([`crate::spectral`]), and picked once per render ([`Estimator`]) so the
@@ -100,8 +101,11 @@ impl Estimator for RgbWavelengths {
 /// integrator is chosen, outside the tile loop.
 pub fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> R {
     let whitted = Transport::Whitted(Whitted { max_bounces: settings.max_bounces });
-    let path = |disperse| Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse });
+    let path = |disperse| {
+        Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
+    };
     match settings.integrator {
+        IntegratorKind::Auto => f.call(&FullSpectrum(path(true))),
         IntegratorKind::Whitted => f.call(&FullSpectrum(whitted)),
         IntegratorKind::Path => f.call(&FullSpectrum(path(false))),
         IntegratorKind::Spectral => {
@@ -117,6 +121,27 @@ pub fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> R {
                 _ => f.call(&Packets::<4>(path(true), how)),
             }
         }
+    }
+}
+
+/// One line saying which light-transport model the settings pick for this
+/// scene and why (printed once by `rust-v render`).
+pub fn describe(scene: &Scene) -> String {
+    let s = &scene.settings;
+    let dispersive = scene.has_dispersion();
+    match s.integrator {
+        IntegratorKind::Auto if dispersive => format!(
+            "auto: dispersive material present: full-spectrum path tracing, collapsing to hero packets of {} wavelengths at a path's first dispersive surface",
+            s.packet_size
+        ),
+        IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),
+        IntegratorKind::Path if dispersive => "path: full spectrum; dispersive glass refracts every wavelength like 589.3 nm (no rainbow)".into(),
+        IntegratorKind::Path => "path: full-spectrum path tracing".into(),
+        IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
+        IntegratorKind::Spectral => match s.wavelengths {
+            WavelengthsKind::Rgb => "spectral, rgb: three wavelengths (435.8, 546.1, 700 nm) read out as RGB".into(),
+            w => format!("spectral, {w:?} packets of {} wavelengths, split at dispersive surfaces", s.packet_size).to_lowercase(),
+        },
     }
 }
 

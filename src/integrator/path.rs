@@ -15,12 +15,13 @@
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
+use crate::color::N_BINS;
 use crate::color::Xyz;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
-use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM, Sampled};
+use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM, Readout, Sampled, hero_bin};
 
 use super::{Shading, sample_direct};
 
@@ -32,9 +33,13 @@ pub const RR_DEPTH: u32 = 5;
 pub struct PathTracer {
     /// Maximum number of scattering events.
     pub max_bounces: u32,
-    /// Whether packets split at dispersive surfaces (the `spectral`
-    /// integrator); without it every wavelength refracts like 589.3 nm.
+    /// Whether packets split at dispersive surfaces (the `spectral` and
+    /// `auto` integrators); without it every wavelength refracts like 589.3 nm.
     pub disperse: bool,
+    /// The hero packet size a full-spectrum path collapses to at its first
+    /// dispersive surface (`auto`); packets smaller than the full spectrum
+    /// split into all their wavelengths.
+    pub collapse_to: u32,
 }
 
 /// What the walk remembers about the previous vertex, for MIS at emitters.
@@ -110,11 +115,28 @@ impl PathTracer {
             if bxdf.is_black() {
                 break;
             }
-            // 3. A dispersive surface splits the packet into single wavelengths.
+            // 3. A dispersive surface splits the packet into single wavelengths;
+            //    the full spectrum first collapses to a hero packet (`auto`).
             if N > 1 && self.disperse && bxdf.is_dispersive() {
-                for i in 0..N {
-                    let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
-                    split = split + self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, false);
+                if N == N_BINS && lambdas.readout == Readout::Spectral {
+                    // Each bin joins the packet with probability C/36: weight 36/C.
+                    let c = self.collapse_to as usize;
+                    let hero = ((sampler.next_1d() * N_BINS as f32) as usize).min(N_BINS - 1);
+                    for k in 0..c {
+                        let bin = hero_bin(hero, k, c);
+                        let one = Walk { beta: Sampled([w.beta[bin]]), ..copy_walk(&w) };
+                        let l1 = Lambdas {
+                            pos: [bin as f32],
+                            weight: lambdas.weight * N_BINS as f32 / c as f32,
+                            readout: Readout::Spectral,
+                        };
+                        split = split + self.walk::<1>(scene, ray, si, one, &l1, sampler, false);
+                    }
+                } else {
+                    for i in 0..N {
+                        let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
+                        split = split + self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, false);
+                    }
                 }
                 break;
             }

@@ -81,7 +81,7 @@ pub struct RenderDesc {
     pub seed: Option<u64>,
     /// Maximum number of scattering events on a path (default 8); see the crate docs.
     pub max_bounces: Option<u32>,
-    /// Integrator: `path`, `whitted` or `spectral` (default `path`).
+    /// Integrator: `auto`, `path`, `whitted` or `spectral` (default `auto`).
     pub integrator: Option<IntegratorKind>,
     /// Wavelength sampling of the `spectral` integrator: `hero`, `random` or `rgb` (default `hero`).
     pub wavelengths: Option<WavelengthsKind>,
@@ -93,6 +93,8 @@ pub struct RenderDesc {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum IntegratorKind {
+    /// The default: full spectrum until a path meets a dispersive surface, then hero packets that split.
+    Auto,
     /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
     Path,
     /// Whitted-style recursive ray tracing: E S* (D|G) L.

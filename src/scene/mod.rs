@@ -64,7 +64,7 @@ impl Default for Settings {
             spp: 64,
             seed: 0,
             max_bounces: 8,
-            integrator: IntegratorKind::Path,
+            integrator: IntegratorKind::Auto,
             wavelengths: WavelengthsKind::Hero,
             packet_size: 4,
         }
