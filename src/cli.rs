@@ -1,20 +1,25 @@
 //! The command line: subcommands and flags (clap derive), and what each does.
 //!
 //! `main` only parses, calls [`run`], prints the error and picks the exit code.
+//! `render` and `resume` run through [`crate::session`] (signals, snapshots,
+//! checkpoints); `merge` combines checkpoints of disjoint pass ranges.
 
 use std::io::Write;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 use clap::builder::TypedValueParser;
 use clap::{Args, Parser, Subcommand};
 
+use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
 use rust_v::error::{Error, Result};
 use rust_v::film::Film;
-use rust_v::render::{Limits, Progress, render};
+use rust_v::render::Progress;
 use rust_v::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
 use rust_v::scene::{Scene, load_scene};
+
+use crate::session::{Session, SessionPlan};
 
 /// rust-v: a physically based spectral path tracer.
 #[derive(Debug, Parser)]
@@ -29,7 +34,14 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Render a RON scene file to a 16-bit sRGB PNG (or a linear EXR).
+    ///
+    /// While it runs: SIGUSR1 writes a PNG snapshot (NAME-00128.png), SIGUSR2
+    /// a checkpoint, SIGINT/SIGTERM both and then exit 0.
     Render(RenderArgs),
+    /// Continue a render from a checkpoint and write its image.
+    Resume(ResumeArgs),
+    /// Sum checkpoints of disjoint pass ranges of one scene into an image or a checkpoint.
+    Merge(MergeArgs),
 }
 
 /// Flags of `render`. Settings given here override the scene file's `render` block.
@@ -48,6 +60,82 @@ pub struct RenderArgs {
     /// No progress bar or summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Render only passes A to B-1 (`A..B`), e.g. one job's share of a distributed render.
+    #[arg(long, value_name = "A..B", value_parser = parse_pass_range)]
+    pub passes: Option<Range<u32>>,
+    #[command(flatten)]
+    pub checkpoint: CheckpointArgs,
+}
+
+/// Checkpoint flags shared by `render` and `resume`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct CheckpointArgs {
+    /// Checkpoint file (default: the output's name with `.ckpt`). When given, the
+    /// checkpoint is also written when the render finishes.
+    #[arg(long, value_name = "PATH")]
+    pub checkpoint: Option<PathBuf>,
+    /// Write a checkpoint every SECONDS (between passes).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub checkpoint_every: Option<f64>,
+}
+
+/// Flags of `resume`.
+#[derive(Debug, Args)]
+pub struct ResumeArgs {
+    /// The checkpoint to continue.
+    pub checkpoint_file: PathBuf,
+    /// Total samples per pixel to reach (default: the original target).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
+    /// Output image, `.png` or `.exr` (default: the original render's output).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress bar or summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Checkpoint file (default: the checkpoint resumed). When given, the
+    /// checkpoint is also written when the render finishes.
+    #[arg(long, value_name = "PATH")]
+    pub checkpoint: Option<PathBuf>,
+    /// Write a checkpoint every SECONDS (between passes).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub checkpoint_every: Option<f64>,
+}
+
+/// Flags of `merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Checkpoints of disjoint pass ranges of the same scene and settings.
+    #[arg(required = true, value_name = "PART.ckpt")]
+    pub parts: Vec<PathBuf>,
+    /// Output: `.png` or `.exr` writes the image, `.ckpt` a merged checkpoint.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// No summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `A..B` with A < B.
+fn parse_pass_range(s: &str) -> std::result::Result<Range<u32>, String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B (e.g. 0..64), got {s:?}"))?;
+    let a: u32 = a.trim().parse().map_err(|e| format!("start {a:?}: {e}"))?;
+    let b: u32 = b.trim().parse().map_err(|e| format!("end {b:?}: {e}"))?;
+    if a >= b {
+        return Err(format!("{a}..{b} is empty: the end must be greater than the start"));
+    }
+    Ok(a..b)
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a positive number of seconds, got {s:?}")),
+    }
 }
 
 /// Render settings shared by the subcommands that render.
@@ -99,10 +187,12 @@ impl SettingsArgs {
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(args) => render_command(args),
+        Command::Resume(args) => resume_command(args),
+        Command::Merge(args) => merge_command(args),
     }
 }
 
-fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
+pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         b = b.num_threads(n as usize);
@@ -116,6 +206,9 @@ fn default_output(scene: &Path) -> PathBuf {
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
+    // Signals first: from here on SIGUSR1/2 no longer kill the process, and
+    // the first line on stderr tells a script that it may send them.
+    let session = Session::start()?;
     let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
     check_output_extension(&output)?;
     let load_start = Instant::now();
@@ -137,30 +230,130 @@ fn render_command(args: RenderArgs) -> Result<()> {
             rust_v::integrator::describe(&scene)
         );
     }
-    let mut film = Film::new(s.width, s.height);
-    let stop = AtomicBool::new(false);
-    let pool = thread_pool(args.threads)?;
-    let mut bar = ProgressBar::new(args.quiet);
-    let stats = pool.install(|| {
-        render(&scene, &mut film, 0..s.spp, Limits { stop: &stop, time_budget: None }, &mut |_, p| bar.update(p))
-    });
-    bar.finish();
-    film.write(&output)?;
-    report(&scene, &stats, &output, args.quiet);
+    let passes = args.passes.clone().unwrap_or(0..s.spp);
+    let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
+    let checkpoint = Checkpoint {
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+        scene_path,
+        content_hash: scene.content_hash,
+        settings: scene.settings.clone(),
+        target_end: passes.end,
+        output: std::path::absolute(&output).map_err(|e| Error::io(&output, e))?,
+        film: Film::starting_at(s.width, s.height, passes.start),
+    };
+    let plan = SessionPlan {
+        checkpoint_path: args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output)),
+        final_checkpoint: args.checkpoint.checkpoint.is_some(),
+        every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
+        output,
+        threads: args.threads,
+        quiet: args.quiet,
+    };
+    session.run(&scene, checkpoint, passes.end, &plan)
+}
+
+fn resume_command(args: ResumeArgs) -> Result<()> {
+    let session = Session::start()?;
+    let mut ckpt = Checkpoint::read(&args.checkpoint_file)?;
+    let path = &args.checkpoint_file;
+    if ckpt.crate_version != env!("CARGO_PKG_VERSION") && !args.quiet {
+        eprintln!(
+            "rust-v: warning: {} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
+            path.display(),
+            ckpt.crate_version,
+            env!("CARGO_PKG_VERSION")
+        );
+    }
+    let done = ckpt.passes();
+    let end = match args.spp {
+        Some(n) => done.start.checked_add(n).ok_or_else(|| Error::Settings(format!("--spp {n} is too large")))?,
+        None => ckpt.target_end,
+    };
+    if args.spp.is_some() {
+        ckpt.settings.spp = end - done.start;
+    }
+    let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
+    check_output_extension(&output)?;
+    let scene = load_scene(&ckpt.scene_path, &ckpt.overrides())
+        .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
+    if scene.content_hash != ckpt.content_hash {
+        return Err(Error::checkpoint(
+            path,
+            format!(
+                "the scene file {} changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same scene",
+                ckpt.scene_path.display(),
+                scene.content_hash,
+                ckpt.content_hash
+            ),
+        ));
+    }
+    if scene.settings != ckpt.settings {
+        return Err(Error::checkpoint(path, format!("its settings {:?} load as {:?}", ckpt.settings, scene.settings)));
+    }
+    if !args.quiet {
+        eprintln!(
+            "rust-v: resuming {} ({}): passes {}..{} done, rendering to pass {}",
+            path.display(),
+            ckpt.scene_path.display(),
+            done.start,
+            done.end,
+            end.max(done.end)
+        );
+    }
+    ckpt.target_end = end.max(done.end);
+    ckpt.output = std::path::absolute(&output).map_err(|e| Error::io(&output, e))?;
+    let plan = SessionPlan {
+        checkpoint_path: args.checkpoint.clone().unwrap_or_else(|| path.clone()),
+        final_checkpoint: args.checkpoint.is_some(),
+        every: args.checkpoint_every.map(Duration::from_secs_f64),
+        output,
+        threads: args.threads,
+        quiet: args.quiet,
+    };
+    session.run(&scene, ckpt, end, &plan)
+}
+
+fn merge_command(args: MergeArgs) -> Result<()> {
+    let is_ckpt = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("ckpt"));
+    if !is_ckpt {
+        check_output_extension(&args.output)
+            .map_err(|_| Error::Settings(format!("output {}: expected .png, .exr or .ckpt", args.output.display())))?;
+    }
+    let mut parts = Vec::with_capacity(args.parts.len());
+    for p in &args.parts {
+        parts.push((p.clone(), Checkpoint::read(p)?));
+    }
+    let merged = merge(parts)?;
+    if is_ckpt {
+        merged.write(&args.output)?;
+    } else {
+        merged.film.write(&args.output)?;
+    }
+    if !args.quiet {
+        let r = merged.passes();
+        eprintln!(
+            "rust-v: merged {} checkpoints (passes {}..{}) into {}",
+            args.parts.len(),
+            r.start,
+            r.end,
+            args.output.display()
+        );
+    }
     Ok(())
 }
 
-fn check_output_extension(output: &Path) -> Result<()> {
+pub(crate) fn check_output_extension(output: &Path) -> Result<()> {
     match output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()) {
         Some(e) if e == "png" || e == "exr" => Ok(()),
         _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", output.display()))),
     }
 }
 
-fn report(scene: &Scene, stats: &rust_v::render::RenderStats, output: &Path, quiet: bool) {
+/// Prints the warnings and the summary of a finished render.
+pub fn report(scene: &Scene, stats: &rust_v::render::RenderStats, output: &Path, quiet: bool) {
     if stats.invalid_samples > 0 {
         eprintln!(
-            "rust-v: warning: {} samples were NaN or infinite and were dropped (a bug: please report it)",
+            "rust-v: warning: {} samples were NaN, infinite (dropped) or beyond ±2^31 (clamped): a bug, please report it",
             stats.invalid_samples
         );
     }
@@ -177,17 +370,19 @@ fn report(scene: &Scene, stats: &rust_v::render::RenderStats, output: &Path, qui
 }
 
 /// A one-line progress bar on stderr: passes done, samples per second, time left.
-struct ProgressBar {
+pub struct ProgressBar {
     quiet: bool,
     last: Option<Instant>,
 }
 
 impl ProgressBar {
-    fn new(quiet: bool) -> Self {
+    /// A bar that prints nothing when `quiet`.
+    pub fn new(quiet: bool) -> Self {
         ProgressBar { quiet, last: None }
     }
 
-    fn update(&mut self, p: &Progress) {
+    /// Redraws the bar (at most every 200 ms, and after the last pass).
+    pub fn update(&mut self, p: &Progress) {
         let done = p.passes_this_run == p.passes_planned;
         if self.quiet || (!done && self.last.is_some_and(|t| t.elapsed() < Duration::from_millis(200))) {
             return;
@@ -212,9 +407,11 @@ impl ProgressBar {
         let _ = err.flush();
     }
 
-    fn finish(&self) {
+    /// Ends the bar's line.
+    pub fn finish(&mut self) {
         if !self.quiet && self.last.is_some() {
             eprintln!();
         }
+        self.last = None;
     }
 }

@@ -1,7 +1,7 @@
 //! The library's error type.
 //!
 //! Every error a user can cause (a missing file, a RON syntax error, an unknown
-//! field or name, a broken mesh, a bad size) becomes an [`Error`] that names the
+//! field or name, a broken mesh, a bad size, a foreign or corrupt checkpoint) becomes an [`Error`] that names the
 //! file and, where known, the line:column or the field path, and says what was
 //! expected. Only `main` prints it; library code never panics on user input.
 
@@ -43,6 +43,13 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A checkpoint that cannot be read, resumed or merged.
+    Checkpoint {
+        /// The checkpoint file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// Invalid settings (command line or scene), e.g. a zero width.
     Settings(String),
 }
@@ -56,6 +63,11 @@ impl Error {
     /// A mesh error on `path`.
     pub fn mesh(path: &Path, message: impl Into<String>) -> Self {
         Error::Mesh { path: path.to_path_buf(), message: message.into() }
+    }
+
+    /// A checkpoint error on `path`.
+    pub fn checkpoint(path: &Path, message: impl Into<String>) -> Self {
+        Error::Checkpoint { path: path.to_path_buf(), message: message.into() }
     }
 
     /// A scene error at a field path, without a position.
@@ -80,6 +92,7 @@ impl fmt::Display for Error {
             }
             Error::Mesh { path, message } => write!(f, "mesh {}: {}", path.display(), message),
             Error::Image { path, message } => write!(f, "image {}: {}", path.display(), message),
+            Error::Checkpoint { path, message } => write!(f, "checkpoint {}: {}", path.display(), message),
             Error::Settings(message) => write!(f, "{message}"),
         }
     }

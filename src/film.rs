@@ -1,10 +1,30 @@
-//! The film: per-pixel sums of XYZ in f64, and the image files made from them.
+//! The film: per-pixel sums of XYZ in exact fixed point, the passes they
+//! hold, and the image files made from them.
 //!
-//! The film stores what the output needs and nothing more: three f64 sums
-//! per pixel (not 36 floats; 24 bytes per pixel), because every integrator
-//! reduces a sample to XYZ before it reaches the film. Samples are added one
-//! whole pass at a time, each pixel in pass order, so the sums (and so the
-//! image) do not depend on thread count or tile order.
+//! The film stores what the output needs and nothing more: three sums per
+//! pixel (XYZ, not 36 floats), because every integrator reduces a sample to
+//! XYZ before it reaches the film. It also records which passes it holds, a
+//! contiguous range `[first, first + passes)`, so that checkpoints can be
+//! resumed and films of disjoint pass ranges merged.
+//!
+//! # Why fixed point
+//! Sums of f64 depend on the order of the additions in their last bits:
+//! `(s(0..50)) + (s(50..100))` is not the f64 sum a single render accumulates
+//! pass by pass. Integer addition is exactly associative, so each f32 sample
+//! is converted to a signed 128-bit fixed-point number with [`FRAC_BITS`] = 64
+//! fractional bits and added as an integer. Merging films of 0..50 and
+//! 50..100, or resuming a checkpoint, then gives bit for bit the sums (and the
+//! image) of one render of 0..100, in any merge order.
+//!
+//! Range and precision (48 bytes per pixel in memory):
+//! - A sample converts **exactly** when `|v| >= 2^-41` (≈ 4.5e-13): its 24-bit
+//!   mantissa then lies above 2^-64. Smaller magnitudes are rounded to the
+//!   nearest multiple of 2^-64 (≈ 5.4e-20): an absolute error far below
+//!   anything an f32 EXR or a 16-bit PNG can show.
+//! - Samples are clamped to `±`[`MAX_SAMPLE`] = 2^31 (≈ 2.1e9, a billion
+//!   times a bright light: only a bug produces it) and counted as invalid.
+//!   With that bound, even `u32::MAX` passes cannot overflow an `i128`
+//!   ((2^32 − 1) · 2^31 · 2^64 < 2^127), so every sum is exact.
 //!
 //! # Output
 //! - PNG: 16-bit sRGB. The mean XYZ of each pixel goes to linear sRGB (D65,
@@ -14,10 +34,35 @@
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
 //!   unclamped, for measurements.
 
+use std::io::Cursor;
+use std::ops::Range;
 use std::path::Path;
 
+pub use crate::atomic_file::temp_path;
+use crate::atomic_file::write_atomic;
 use crate::color::{Xyz, srgb_oetf, xyz_to_linear_srgb_f64};
 use crate::error::{Error, Result};
+
+/// Fractional bits of the fixed-point sums.
+pub const FRAC_BITS: u32 = 64;
+
+/// The largest sample magnitude the film accepts; larger ones are clamped.
+pub const MAX_SAMPLE: f32 = 2147483648.0; // 2^31
+
+/// 2^FRAC_BITS as an f64 (exact).
+const SCALE: f64 = 18446744073709551616.0; // 2^64
+
+/// One f32 sample as a fixed-point integer (exact for `|v| >= 2^-41`).
+#[inline]
+pub fn to_fixed(v: f32) -> i128 {
+    (v.clamp(-MAX_SAMPLE, MAX_SAMPLE) as f64 * SCALE).round() as i128
+}
+
+/// A fixed-point sum as an f64 (rounded to nearest).
+#[inline]
+pub fn from_fixed(v: i128) -> f64 {
+    v as f64 / SCALE
+}
 
 /// A rectangle of pixels `[x0, x1) × [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,21 +100,49 @@ pub fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
     out
 }
 
-/// Per-pixel XYZ sums over whole passes.
+/// Per-pixel XYZ sums (fixed point, see the module docs) over a contiguous
+/// range of whole passes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     width: u32,
     height: u32,
-    /// Row-major sums of XYZ.
-    pub sums: Vec<[f64; 3]>,
+    /// Row-major sums of XYZ, scaled by 2^[`FRAC_BITS`].
+    sums: Vec<[i128; 3]>,
+    /// The first pass held.
+    first_pass: u32,
     /// Passes (samples per pixel) summed so far.
-    pub passes: u32,
+    passes: u32,
 }
 
 impl Film {
-    /// An empty film.
+    /// An empty film (its pass range starts where the first render starts).
     pub fn new(width: u32, height: u32) -> Self {
-        Film { width, height, sums: vec![[0.0; 3]; (width * height) as usize], passes: 0 }
+        Film { width, height, sums: vec![[0; 3]; width as usize * height as usize], first_pass: 0, passes: 0 }
+    }
+
+    /// An empty film whose first pass will be `first_pass` (a render of a
+    /// pass range `first_pass..`).
+    pub fn starting_at(width: u32, height: u32, first_pass: u32) -> Self {
+        Film { first_pass, ..Film::new(width, height) }
+    }
+
+    /// A film from stored parts (a checkpoint). Fails when the number of
+    /// sums does not match the size, the pass range is invalid, or a sum is
+    /// larger than its number of passes allows (so later additions cannot
+    /// overflow).
+    pub fn from_parts(width: u32, height: u32, passes: Range<u32>, sums: Vec<[i128; 3]>) -> Result<Self, String> {
+        if sums.len() != width as usize * height as usize {
+            return Err(format!("{} pixel sums for a {width}x{height} film", sums.len()));
+        }
+        if passes.end < passes.start {
+            return Err(format!("invalid pass range {}..{}", passes.start, passes.end));
+        }
+        let n = passes.end - passes.start;
+        let bound = to_fixed(MAX_SAMPLE) * n as i128;
+        if let Some(i) = sums.iter().position(|s| s.iter().any(|v| v.unsigned_abs() > bound.unsigned_abs())) {
+            return Err(format!("pixel {i} holds a sum out of range for {n} passes"));
+        }
+        Ok(Film { width, height, sums, first_pass: passes.start, passes: n })
     }
 
     /// Width in pixels.
@@ -82,15 +155,42 @@ impl Film {
         self.height
     }
 
+    /// Passes (samples per pixel) summed so far.
+    pub fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    /// The passes held: `first..first + passes`.
+    pub fn pass_range(&self) -> Range<u32> {
+        self.first_pass..self.first_pass + self.passes
+    }
+
+    /// The row-major fixed-point sums (X, Y, Z scaled by 2^[`FRAC_BITS`]).
+    pub fn sums(&self) -> &[[i128; 3]] {
+        &self.sums
+    }
+
+    /// Makes an empty film start at pass `first` (the renderer does this).
+    pub(crate) fn start_at(&mut self, first: u32) {
+        debug_assert_eq!(self.passes, 0);
+        self.first_pass = first;
+    }
+
+    /// Records that one more whole pass has been added (the renderer does this).
+    pub(crate) fn end_pass(&mut self) {
+        self.passes += 1;
+    }
+
     /// Adds one sample per pixel of `tile` (row-major within the tile).
-    /// Returns the number of non-finite samples, which are dropped (counted
-    /// and reported by the renderer: they are bugs, never expected).
+    /// Returns the number of invalid samples: non-finite ones are dropped,
+    /// ones beyond ±[`MAX_SAMPLE`] are clamped. Both are counted and reported
+    /// by the renderer: they are bugs, never expected.
     pub fn add_tile(&mut self, tile: &Tile, samples: &[Xyz]) -> usize {
         debug_assert_eq!(samples.len(), tile.len());
         let mut bad = 0;
         let mut k = 0;
         for y in tile.y0..tile.y1 {
-            let row = (y * self.width) as usize;
+            let row = y as usize * self.width as usize;
             for x in tile.x0..tile.x1 {
                 let s = samples[k];
                 k += 1;
@@ -98,19 +198,48 @@ impl Film {
                     bad += 1;
                     continue;
                 }
+                if s.x.abs().max(s.y.abs()).max(s.z.abs()) > MAX_SAMPLE {
+                    bad += 1;
+                }
                 let sum = &mut self.sums[row + x as usize];
-                sum[0] += s.x as f64;
-                sum[1] += s.y as f64;
-                sum[2] += s.z as f64;
+                sum[0] += to_fixed(s.x);
+                sum[1] += to_fixed(s.y);
+                sum[2] += to_fixed(s.z);
             }
         }
         bad
     }
 
+    /// Adds the passes of `other`, which must be the same size and hold the
+    /// passes right after this film's (or this film must be empty). The
+    /// result is bit-identical to one render of the combined range.
+    pub fn merge(&mut self, other: &Film) -> Result<(), String> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return Err(format!(
+                "a {}x{} film cannot be merged with a {}x{} one",
+                other.width, other.height, self.width, self.height
+            ));
+        }
+        if self.passes == 0 {
+            self.first_pass = other.first_pass;
+        } else if other.passes > 0 && other.first_pass != self.pass_range().end {
+            let (a, b) = (self.pass_range(), other.pass_range());
+            return Err(format!("passes {}..{} do not follow passes {}..{}", b.start, b.end, a.start, a.end));
+        }
+        let passes = self.passes.checked_add(other.passes).ok_or("more than 2^32 passes")?;
+        for (s, o) in self.sums.iter_mut().zip(&other.sums) {
+            for c in 0..3 {
+                s[c] = s[c].checked_add(o[c]).ok_or("a pixel sum overflows")?;
+            }
+        }
+        self.passes = passes;
+        Ok(())
+    }
+
     /// The mean XYZ of every pixel, row-major.
     pub fn mean_xyz(&self) -> Vec<[f64; 3]> {
         let inv = if self.passes == 0 { 0.0 } else { 1.0 / self.passes as f64 };
-        self.sums.iter().map(|s| s.map(|v| v * inv)).collect()
+        self.sums.iter().map(|s| s.map(|v| from_fixed(v) * inv)).collect()
     }
 
     /// The mean linear sRGB of every pixel, row-major, unclamped.
@@ -119,24 +248,28 @@ impl Film {
     }
 
     /// Writes the image: linear EXR if `path` ends in `.exr`, else 16-bit sRGB PNG.
-    /// The file is written under a temporary name and renamed into place.
+    /// The file is encoded in memory, written under a temporary name, synced
+    /// and renamed into place, so `path` never holds a partial image.
     pub fn write(&self, path: &Path) -> Result<()> {
         let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
         let rgb = self.linear_srgb();
-        let tmp = temp_path(path);
-        let result = if is_exr {
+        let mut bytes = Cursor::new(Vec::new());
+        let image_error = |e: image::ImageError| Error::Image { path: path.to_path_buf(), message: e.to_string() };
+        let size_error = || Error::Image { path: path.to_path_buf(), message: "buffer size does not match".into() };
+        if is_exr {
             let data: Vec<f32> = rgb.iter().flat_map(|p| p.map(|v| v as f32)).collect();
             image::Rgb32FImage::from_raw(self.width, self.height, data)
-                .expect("buffer size matches the film")
-                .save_with_format(&tmp, image::ImageFormat::OpenExr)
+                .ok_or_else(size_error)?
+                .write_to(&mut bytes, image::ImageFormat::OpenExr)
+                .map_err(image_error)?;
         } else {
             let data: Vec<u16> = rgb.iter().flat_map(|p| p.map(encode_u16)).collect();
             image::ImageBuffer::<image::Rgb<u16>, Vec<u16>>::from_raw(self.width, self.height, data)
-                .expect("buffer size matches the film")
-                .save_with_format(&tmp, image::ImageFormat::Png)
-        };
-        result.map_err(|e| Error::Image { path: path.to_path_buf(), message: e.to_string() })?;
-        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
+                .ok_or_else(size_error)?
+                .write_to(&mut bytes, image::ImageFormat::Png)
+                .map_err(image_error)?;
+        }
+        write_atomic(path, &bytes.into_inner())
     }
 }
 
@@ -145,12 +278,6 @@ impl Film {
 pub fn encode_u16(linear: f64) -> u16 {
     let v = if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) as f32 };
     (srgb_oetf(v) * 65535.0 + 0.5) as u16
-}
-
-/// `dir/.name.tmp-PID`: a temporary name in the same directory (so the rename is atomic).
-pub fn temp_path(path: &Path) -> std::path::PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
 }
 
 #[cfg(test)]
@@ -188,6 +315,46 @@ mod tests {
         let t = Tile { x0: 0, y0: 0, x1: 2, y1: 1 };
         let bad = f.add_tile(&t, &[Xyz::new(f32::NAN, 0.0, 0.0), Xyz::new(1.0, 2.0, 3.0)]);
         assert_eq!(bad, 1);
-        assert_eq!(f.sums, vec![[0.0; 3], [1.0, 2.0, 3.0]]);
+        assert_eq!(f.sums, vec![[0; 3], [to_fixed(1.0), to_fixed(2.0), to_fixed(3.0)]]);
+    }
+
+    #[test]
+    fn fixed_point_is_exact_in_its_range_and_clamps_outside() {
+        for v in [1.0f32, 0.1, 3.5e-12, 1e6, -0.25, 2147483648.0] {
+            assert_eq!(from_fixed(to_fixed(v)), v as f64, "{v}");
+        }
+        assert_eq!(to_fixed(1e30), to_fixed(MAX_SAMPLE));
+        assert_eq!(to_fixed(1e-25), 0);
+        let mut f = Film::new(1, 1);
+        let t = Tile { x0: 0, y0: 0, x1: 1, y1: 1 };
+        assert_eq!(f.add_tile(&t, &[Xyz::new(1e30, 0.0, 0.0)]), 1);
+    }
+
+    /// f64 sums in another grouping differ; fixed-point sums do not.
+    #[test]
+    fn merging_halves_equals_one_accumulation() {
+        let t = Tile { x0: 0, y0: 0, x1: 1, y1: 1 };
+        // A bright sample, then dim ones each below half an f64 ulp of the sum.
+        let samples: Vec<f32> = (0..100).map(|i| if i == 0 { 2f32.powi(30) } else { 2f32.powi(-25) }).collect();
+        let mut whole = Film::new(1, 1);
+        let (mut a, mut b) = (Film::new(1, 1), Film::new(1, 1));
+        b.start_at(50);
+        for (i, &v) in samples.iter().enumerate() {
+            let x = [Xyz::new(v, v * 0.5, v * 3.0)];
+            whole.add_tile(&t, &x);
+            whole.end_pass();
+            let part = if i < 50 { &mut a } else { &mut b };
+            part.add_tile(&t, &x);
+            part.end_pass();
+        }
+        let mut ab = a.clone();
+        ab.merge(&b).unwrap();
+        assert_eq!(ab, whole);
+        assert!(a.clone().merge(&a).is_err(), "overlap refused");
+        // The f64 way differs in the last bits for these samples.
+        let seq: f64 = samples.iter().fold(0.0, |s, &v| s + v as f64);
+        let halves: f64 =
+            samples[..50].iter().fold(0.0, |s, &v| s + v as f64) + samples[50..].iter().fold(0.0, |s, &v| s + v as f64);
+        assert_ne!(seq, halves, "f64 grouping matters for these samples");
     }
 }

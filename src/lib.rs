@@ -2,7 +2,8 @@
 //!
 //! Data flows one way: **scene file → [`scene::Scene`] → camera ray →
 //! [`integrator`] → [`film::Film`] → image**. The [`render`] module drives it:
-//! progressive passes, tiles in parallel, deterministic per-sample random numbers.
+//! progressive passes, tiles in parallel, deterministic per-sample random numbers;
+//! [`checkpoint`] saves and restores films so renders can be resumed and merged.
 //!
 //! # Conventions
 //! - **Units**: scene units are arbitrary; wavelengths in nm; angles in the
@@ -21,9 +22,11 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod atomic_file;
 pub mod bvh;
 pub mod bxdf;
 pub mod camera;
+pub mod checkpoint;
 pub mod color;
 pub mod error;
 pub mod film;

@@ -66,7 +66,14 @@ pub struct Limits<'a> {
 }
 
 /// Renders passes `passes` (pass indices, whole samples per pixel) into
-/// `film`, calling `on_pass` after each completed pass.
+/// `film`, calling `on_pass` on the calling thread after each completed pass.
+///
+/// An empty film starts at `passes.start`; a film that already holds passes
+/// must end where `passes` starts (a resumed render).
+///
+/// # Panics
+/// When `film` holds passes and `passes` does not continue them: callers
+/// check this (e.g. [`crate::checkpoint`] resume does).
 pub fn render(
     scene: &Scene,
     film: &mut Film,
@@ -88,6 +95,10 @@ struct Run<'a, 'b> {
 impl EstimatorFn<RenderStats> for Run<'_, '_> {
     fn call<E: Estimator>(self, estimator: &E) -> RenderStats {
         let Run { scene, film, passes, limits, on_pass } = self;
+        if film.passes() == 0 {
+            film.start_at(passes.start);
+        }
+        assert_eq!(film.pass_range().end, passes.start, "render must continue the film's passes");
         let tiles = tiles(film.width(), film.height(), TILE_SIZE);
         let start = Instant::now();
         let mut stats = RenderStats::default();
@@ -113,10 +124,10 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
             for (tile, samples) in tiles.iter().zip(results) {
                 stats.invalid_samples += film.add_tile(tile, &samples.unwrap_or_default()) as u64;
             }
-            film.passes += 1;
+            film.end_pass();
             stats.passes += 1;
             let progress = Progress {
-                passes_done: film.passes,
+                passes_done: film.passes(),
                 passes_planned: planned,
                 passes_this_run: stats.passes,
                 elapsed: start.elapsed(),

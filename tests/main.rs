@@ -5,6 +5,7 @@
 
 mod common;
 
+mod checkpoint;
 mod cli;
 mod furnace;
 mod scenes;

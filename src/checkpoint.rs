@@ -1,0 +1,468 @@
+//! Checkpoints: a film's whole passes plus everything needed to resume or
+//! merge them, in a small versioned, checksummed file.
+//!
+//! A render can be stopped and resumed, or split into pass ranges rendered
+//! by different processes and merged, with bit-identical results: the
+//! sampler is keyed by `(seed, pixel, pass)` ([`crate::sampler`]) and the
+//! film's fixed-point sums are exactly associative ([`crate::film`]), so a
+//! checkpoint only has to hold whole passes, their range, the settings, and
+//! which scene they belong to.
+//!
+//! # File format (version 1)
+//! All integers little-endian.
+//!
+//! | bytes | content |
+//! |-------|---------|
+//! | 8 | magic `RUSTVCKP` |
+//! | 4 | format version (`u32`, [`FORMAT_VERSION`]) |
+//! | 4 | header length `H` (`u32`) |
+//! | 8 | payload length `P` (`u64`) |
+//! | 8 | checksum: FNV-1a 64 of the header and payload bytes |
+//! | H | header: bincode (standard config) of the writer's crate version, the scene file's absolute path and content hash, all [`Settings`], the pass range held, the target pass, the output path |
+//! | P | payload: lz4_flex block (size prepended) of bincode of the film: width, height and 3 fixed-point `i128` sums per pixel |
+//!
+//! Reading checks the magic, the version, the exact length (a truncated
+//! file is reported as such), the checksum, then decodes and validates every
+//! field; any failure is an [`Error::Checkpoint`] naming the file. Writing
+//! goes through [`crate::atomic_file`], so the file on disk is always a
+//! complete old or new checkpoint. bincode is used in this module only.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use clap::ValueEnum;
+use serde::{Deserialize, Serialize};
+
+use crate::atomic_file::write_atomic;
+use crate::error::{Error, Result};
+use crate::film::Film;
+use crate::scene::Settings;
+use crate::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
+
+/// The first 8 bytes of every checkpoint.
+pub const MAGIC: [u8; 8] = *b"RUSTVCKP";
+
+/// The format version this build writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Bytes before the header: magic, version, two lengths, checksum.
+const PREFIX_LEN: usize = 32;
+
+/// Headers larger than this are refused (they hold two paths and some numbers).
+const MAX_HEADER_LEN: u32 = 1 << 20;
+
+/// A film with what it takes to resume or merge it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    /// The version of rust-v that wrote it.
+    pub crate_version: String,
+    /// The scene file (absolute path).
+    pub scene_path: PathBuf,
+    /// The scene file's content hash ([`crate::scene::Scene::content_hash`]).
+    pub content_hash: u64,
+    /// All render settings (after command-line overrides).
+    pub settings: Settings,
+    /// The pass the render was heading for: resume continues to it by default.
+    pub target_end: u32,
+    /// The image the render was writing.
+    pub output: PathBuf,
+    /// The passes done so far.
+    pub film: Film,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    crate_version: String,
+    scene_path: PathBuf,
+    content_hash: u64,
+    width: u32,
+    height: u32,
+    spp: u32,
+    seed: u64,
+    max_bounces: u32,
+    integrator: String,
+    wavelengths: String,
+    packet_size: u32,
+    first_pass: u32,
+    end_pass: u32,
+    target_end: u32,
+    output: PathBuf,
+}
+
+#[derive(Serialize)]
+struct PayloadRef<'a> {
+    width: u32,
+    height: u32,
+    sums: &'a [[i128; 3]],
+}
+
+#[derive(Deserialize)]
+struct Payload {
+    width: u32,
+    height: u32,
+    sums: Vec<[i128; 3]>,
+}
+
+/// FNV-1a 64-bit over several byte strings in turn.
+fn checksum(parts: &[&[u8]]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for part in parts {
+        for &b in *part {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+fn value_name<T: ValueEnum>(v: &T) -> String {
+    v.to_possible_value().map(|p| p.get_name().to_owned()).unwrap_or_default()
+}
+
+fn u32_at(b: &[u8], at: usize) -> u32 {
+    let mut a = [0; 4];
+    a.copy_from_slice(&b[at..at + 4]);
+    u32::from_le_bytes(a)
+}
+
+fn u64_at(b: &[u8], at: usize) -> u64 {
+    let mut a = [0; 8];
+    a.copy_from_slice(&b[at..at + 8]);
+    u64::from_le_bytes(a)
+}
+
+impl Checkpoint {
+    /// The settings as scene-loader overrides, so the scene loads exactly as
+    /// it was rendered.
+    pub fn overrides(&self) -> RenderDesc {
+        let s = &self.settings;
+        RenderDesc {
+            width: Some(s.width),
+            height: Some(s.height),
+            spp: Some(s.spp),
+            seed: Some(s.seed),
+            max_bounces: Some(s.max_bounces),
+            integrator: Some(s.integrator),
+            wavelengths: Some(s.wavelengths),
+            packet_size: Some(s.packet_size),
+        }
+    }
+
+    /// The passes held.
+    pub fn passes(&self) -> Range<u32> {
+        self.film.pass_range()
+    }
+
+    /// The file's bytes.
+    pub fn encode(&self) -> Result<Vec<u8>> {
+        self.encode_with(&self.film)
+    }
+
+    /// The file's bytes with `film` in place of this checkpoint's own (a
+    /// render in progress writes its film without copying it).
+    pub fn encode_with(&self, film: &Film) -> Result<Vec<u8>> {
+        let s = &self.settings;
+        let range = film.pass_range();
+        let header = Header {
+            crate_version: self.crate_version.clone(),
+            scene_path: self.scene_path.clone(),
+            content_hash: self.content_hash,
+            width: s.width,
+            height: s.height,
+            spp: s.spp,
+            seed: s.seed,
+            max_bounces: s.max_bounces,
+            integrator: value_name(&s.integrator),
+            wavelengths: value_name(&s.wavelengths),
+            packet_size: s.packet_size,
+            first_pass: range.start,
+            end_pass: range.end,
+            target_end: self.target_end,
+            output: self.output.clone(),
+        };
+        let config = bincode::config::standard();
+        let encode_error =
+            |e: bincode::error::EncodeError| Error::checkpoint(&self.output, format!("cannot encode: {e}"));
+        let header = bincode::serde::encode_to_vec(&header, config).map_err(encode_error)?;
+        let payload = PayloadRef { width: film.width(), height: film.height(), sums: film.sums() };
+        let payload =
+            lz4_flex::compress_prepend_size(&bincode::serde::encode_to_vec(&payload, config).map_err(encode_error)?);
+        let mut out = Vec::with_capacity(PREFIX_LEN + header.len() + payload.len());
+        out.extend_from_slice(&MAGIC);
+        out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&(header.len() as u32).to_le_bytes());
+        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        out.extend_from_slice(&checksum(&[&header, &payload]).to_le_bytes());
+        out.extend_from_slice(&header);
+        out.extend_from_slice(&payload);
+        Ok(out)
+    }
+
+    /// Parses a checkpoint's bytes; `path` names the file in errors.
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<Checkpoint> {
+        let bad = |m: String| Error::checkpoint(path, m);
+        if bytes.len() < MAGIC.len() && MAGIC.starts_with(bytes) {
+            return Err(bad(format!("truncated: {} bytes, not even the magic number", bytes.len())));
+        }
+        if !bytes.starts_with(&MAGIC) {
+            return Err(bad("not a rust-v checkpoint (no RUSTVCKP magic number at the start)".into()));
+        }
+        if bytes.len() < PREFIX_LEN {
+            return Err(bad(format!("truncated: {} bytes, the fixed header alone is {PREFIX_LEN}", bytes.len())));
+        }
+        let version = u32_at(bytes, 8);
+        if version != FORMAT_VERSION {
+            return Err(bad(format!(
+                "format version {version}; this rust-v ({}) reads version {FORMAT_VERSION}",
+                env!("CARGO_PKG_VERSION")
+            )));
+        }
+        let header_len = u32_at(bytes, 12);
+        let payload_len = u64_at(bytes, 16);
+        if header_len > MAX_HEADER_LEN {
+            return Err(bad(format!("corrupt: header length {header_len} is implausible")));
+        }
+        let expected = (PREFIX_LEN as u64 + header_len as u64).saturating_add(payload_len);
+        if (bytes.len() as u64) < expected {
+            return Err(bad(format!("truncated: {} bytes of the {expected} its header announces", bytes.len())));
+        }
+        if bytes.len() as u64 > expected {
+            return Err(bad(format!(
+                "corrupt: {} bytes, {} more than its header announces",
+                bytes.len(),
+                bytes.len() as u64 - expected
+            )));
+        }
+        let header_bytes = &bytes[PREFIX_LEN..PREFIX_LEN + header_len as usize];
+        let payload_bytes = &bytes[PREFIX_LEN + header_len as usize..];
+        if checksum(&[header_bytes, payload_bytes]) != u64_at(bytes, 24) {
+            return Err(bad("corrupt: checksum mismatch (the file was damaged after it was written)".into()));
+        }
+
+        let config = bincode::config::standard();
+        let (h, used): (Header, usize) =
+            bincode::serde::decode_from_slice(header_bytes, config.with_limit::<{ 1 << 20 }>())
+                .map_err(|e| bad(format!("corrupt header: {e}")))?;
+        if used != header_bytes.len() {
+            return Err(bad("corrupt header: trailing bytes".into()));
+        }
+        let integrator = IntegratorKind::from_str(&h.integrator, false)
+            .map_err(|_| bad(format!("unknown integrator {:?}", h.integrator)))?;
+        let wavelengths = WavelengthsKind::from_str(&h.wavelengths, false)
+            .map_err(|_| bad(format!("unknown wavelength sampling {:?}", h.wavelengths)))?;
+        if h.width == 0 || h.height == 0 || h.width > 32768 || h.height > 32768 {
+            return Err(bad(format!("invalid image size {}x{}", h.width, h.height)));
+        }
+        if ![1, 2, 4, 8].contains(&h.packet_size) || h.end_pass < h.first_pass {
+            return Err(bad("corrupt header: invalid packet size or pass range".into()));
+        }
+        let settings = Settings {
+            width: h.width,
+            height: h.height,
+            spp: h.spp,
+            seed: h.seed,
+            max_bounces: h.max_bounces,
+            integrator,
+            wavelengths,
+            packet_size: h.packet_size,
+        };
+
+        // The decompressed size is prepended; bound it by what the film can need
+        // (17 bytes per varint i128) before allocating.
+        let pixels = h.width as u64 * h.height as u64;
+        let limit = pixels * 3 * 17 + 64;
+        if payload_bytes.len() < 4 || u32_at(payload_bytes, 0) as u64 > limit {
+            return Err(bad("corrupt payload: implausible size".into()));
+        }
+        let raw = lz4_flex::decompress_size_prepended(payload_bytes)
+            .map_err(|e| bad(format!("corrupt payload: does not decompress: {e}")))?;
+        let (p, used): (Payload, usize) =
+            bincode::serde::decode_from_slice(&raw, config).map_err(|e| bad(format!("corrupt payload: {e}")))?;
+        if used != raw.len() || (p.width, p.height) != (h.width, h.height) {
+            return Err(bad("corrupt payload: size does not match the header".into()));
+        }
+        let film = Film::from_parts(p.width, p.height, h.first_pass..h.end_pass, p.sums)
+            .map_err(|e| bad(format!("corrupt payload: {e}")))?;
+        Ok(Checkpoint {
+            crate_version: h.crate_version,
+            scene_path: h.scene_path,
+            content_hash: h.content_hash,
+            settings,
+            target_end: h.target_end,
+            output: h.output,
+            film,
+        })
+    }
+
+    /// Writes the checkpoint atomically (never a partial file under `path`);
+    /// returns its size in bytes.
+    pub fn write(&self, path: &Path) -> Result<u64> {
+        self.write_with(&self.film, path)
+    }
+
+    /// [`Checkpoint::write`] with `film` in place of this checkpoint's own.
+    pub fn write_with(&self, film: &Film, path: &Path) -> Result<u64> {
+        let bytes = self.encode_with(film)?;
+        write_atomic(path, &bytes)?;
+        Ok(bytes.len() as u64)
+    }
+
+    /// Reads and verifies a checkpoint file.
+    pub fn read(path: &Path) -> Result<Checkpoint> {
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        Checkpoint::decode(&bytes, path)
+    }
+
+    /// Why `other` cannot be merged with `self`: a different scene, or
+    /// different settings other than the target `spp` (which does not change
+    /// any sample).
+    pub fn incompatibility(&self, other: &Checkpoint) -> Option<String> {
+        if self.content_hash != other.content_hash {
+            return Some(format!(
+                "different scene: {} (content hash {:016x}) vs {} (content hash {:016x})",
+                other.scene_path.display(),
+                other.content_hash,
+                self.scene_path.display(),
+                self.content_hash
+            ));
+        }
+        let (a, b) = (&self.settings, &other.settings);
+        let mut diffs = Vec::new();
+        let mut check = |name: &str, x: String, y: String| {
+            if x != y {
+                diffs.push(format!("{name} {y} vs {x}"));
+            }
+        };
+        check("width", a.width.to_string(), b.width.to_string());
+        check("height", a.height.to_string(), b.height.to_string());
+        check("seed", a.seed.to_string(), b.seed.to_string());
+        check("max_bounces", a.max_bounces.to_string(), b.max_bounces.to_string());
+        check("integrator", value_name(&a.integrator), value_name(&b.integrator));
+        check("wavelengths", value_name(&a.wavelengths), value_name(&b.wavelengths));
+        check("packet_size", a.packet_size.to_string(), b.packet_size.to_string());
+        (!diffs.is_empty()).then(|| format!("different settings: {}", diffs.join(", ")))
+    }
+}
+
+/// Merges checkpoints of disjoint pass ranges of one scene and settings, in
+/// any order, into one whose film is bit-identical to a single render of the
+/// combined range. The ranges must tile a contiguous range: overlaps, gaps,
+/// different scenes or different settings are refused, naming the file.
+pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
+    if parts.is_empty() {
+        return Err(Error::Settings("merge: no checkpoints given".into()));
+    }
+    parts.retain(|(_, c)| c.film.passes() > 0);
+    if parts.is_empty() {
+        return Err(Error::Settings("merge: every checkpoint is empty (0 passes)".into()));
+    }
+    parts.sort_by_key(|(_, c)| c.passes().start);
+    let (first_path, first) = &parts[0];
+    let mut merged = first.clone();
+    let mut prev_path = first_path.clone();
+    for (path, c) in &parts[1..] {
+        if let Some(why) = merged.incompatibility(c) {
+            return Err(Error::checkpoint(path, format!("cannot be merged with {}: {why}", first_path.display())));
+        }
+        let (have, next) = (merged.passes(), c.passes());
+        if next.start < have.end {
+            return Err(Error::checkpoint(
+                path,
+                format!(
+                    "its passes {}..{} overlap passes {}..{} of {}",
+                    next.start,
+                    next.end,
+                    have.start,
+                    have.end,
+                    prev_path.display()
+                ),
+            ));
+        }
+        if next.start > have.end {
+            return Err(Error::checkpoint(
+                path,
+                format!(
+                    "passes {}..{} are missing between {} (ends at {}) and this file (starts at {})",
+                    have.end,
+                    next.start,
+                    prev_path.display(),
+                    have.end,
+                    next.start
+                ),
+            ));
+        }
+        merged.film.merge(&c.film).map_err(|e| Error::checkpoint(path, e))?;
+        merged.target_end = merged.target_end.max(c.target_end);
+        merged.settings.spp = merged.settings.spp.max(c.settings.spp);
+        prev_path = path.clone();
+    }
+    merged.target_end = merged.target_end.max(merged.passes().end);
+    Ok(merged)
+}
+
+/// `dir/stem-00128.png` for `dir/stem.ext` after 128 passes: a snapshot's name.
+pub fn snapshot_path(output: &Path, passes: u32) -> PathBuf {
+    let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "render".into());
+    output.with_file_name(format!("{stem}-{passes:05}.png"))
+}
+
+/// `dir/stem.ckpt` for `dir/stem.ext`: where a render checkpoints by default.
+pub fn default_checkpoint_path(output: &Path) -> PathBuf {
+    output.with_extension("ckpt")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Xyz;
+    use crate::film::tiles;
+
+    fn sample() -> Checkpoint {
+        let mut film = Film::new(5, 3);
+        for (i, t) in tiles(5, 3, 2).iter().enumerate() {
+            let s: Vec<Xyz> = (0..t.len()).map(|k| Xyz::new(i as f32 * 0.3, k as f32 + 0.1, 1e-3)).collect();
+            film.add_tile(t, &s);
+        }
+        film.start_at(7);
+        film.end_pass();
+        Checkpoint {
+            crate_version: env!("CARGO_PKG_VERSION").into(),
+            scene_path: "/scenes/x.ron".into(),
+            content_hash: 0x1234,
+            settings: Settings { width: 5, height: 3, ..Settings::default() },
+            target_end: 20,
+            output: "/out/x.png".into(),
+            film,
+        }
+    }
+
+    #[test]
+    fn round_trip() {
+        let c = sample();
+        let bytes = c.encode().unwrap();
+        assert_eq!(Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap(), c);
+    }
+
+    #[test]
+    fn every_truncation_and_every_flipped_byte_is_a_clear_error() {
+        let bytes = sample().encode().unwrap();
+        let p = Path::new("dir/x.ckpt");
+        for n in 0..bytes.len() {
+            let e = Checkpoint::decode(&bytes[..n], p).unwrap_err().to_string();
+            assert!(e.starts_with("checkpoint dir/x.ckpt: ") && e.contains("truncated"), "{n}: {e}");
+        }
+        for i in 0..bytes.len() {
+            let mut b = bytes.clone();
+            b[i] ^= 0x10;
+            let e = Checkpoint::decode(&b, p).unwrap_err().to_string();
+            assert!(e.starts_with("checkpoint dir/x.ckpt: "), "{i}: {e}");
+        }
+        let e = Checkpoint::decode(b"\x89PNG\r\n\x1a\n and more", p).unwrap_err().to_string();
+        assert!(e.contains("not a rust-v checkpoint"), "{e}");
+    }
+
+    #[test]
+    fn names() {
+        assert_eq!(snapshot_path(Path::new("out/cornell.png"), 128), Path::new("out/cornell-00128.png"));
+        assert_eq!(default_checkpoint_path(Path::new("out/cornell.exr")), Path::new("out/cornell.ckpt"));
+    }
+}
