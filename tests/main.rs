@@ -5,6 +5,7 @@
 
 mod common;
 
+mod auto;
 mod checkpoint;
 mod cli;
 mod furnace;

@@ -100,7 +100,7 @@ fn glass_sphere_in_a_furnace_is_invisible() {
 
 /// Per-block means over `seeds` independent renders: block values and their
 /// standard errors from the seed-to-seed spread.
-fn block_stats(scene: &str, o: impl Fn(u64) -> RenderDesc, seeds: u64, block: usize) -> Vec<(f64, f64)> {
+pub(crate) fn block_stats(scene: &str, o: impl Fn(u64) -> RenderDesc, seeds: u64, block: usize) -> Vec<(f64, f64)> {
     let films: Vec<Film> = (0..seeds).map(|s| render_str(scene, &o(s))).collect();
     let (w, h) = (films[0].width() as usize, films[0].height() as usize);
     let mut out = Vec::new();
@@ -136,7 +136,7 @@ fn block_stats(scene: &str, o: impl Fn(u64) -> RenderDesc, seeds: u64, block: us
 /// under a normal approximation (Student t with 7 d.o.f. is heavier-tailed,
 /// which the 5 sigma also covers at about 0.2% per comparison... so the
 /// bound uses 6 sigma: p < 0.1% per comparison, < 5% over all 48).
-fn assert_same_image(a: &[(f64, f64)], b: &[(f64, f64)], what: &str) {
+pub(crate) fn assert_same_image(a: &[(f64, f64)], b: &[(f64, f64)], what: &str) {
     for (i, (x, y)) in a.iter().zip(b).enumerate() {
         let se = (x.1 * x.1 + y.1 * y.1).sqrt();
         let z = (x.0 - y.0).abs() / se.max(1e-12);
