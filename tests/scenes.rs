@@ -75,3 +75,19 @@ fn render_is_bit_identical_for_any_thread_count() {
     assert_eq!(outputs[0], outputs[1], "1 vs 2 threads");
     assert_eq!(outputs[0], outputs[2], "1 vs 3 threads");
 }
+
+/// The scene-format example in the README parses and loads (it uses every
+/// shape, material, spectrum and IOR form), so the documentation stays true.
+#[test]
+fn readme_scene_example_loads() {
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let start = readme.find("```ron\n").expect("README has a ```ron block") + "```ron\n".len();
+    let end = start + readme[start..].find("```").unwrap();
+    let example = &readme[start..end];
+    // Paths in the example are relative to a scene in scenes/.
+    let scene = rust_v::scene::load_scene_str(example, &root().join("scenes/readme-example.ron"), &Default::default())
+        .unwrap_or_else(|e| panic!("README example: {e}"));
+    assert_eq!(scene.object_count(), 8);
+    assert_eq!(scene.lights.len(), 3, "disk, sphere and point lights");
+    assert!(scene.has_dispersion());
+}

@@ -20,8 +20,10 @@ use crate::light::Light;
 use desc::{IntegratorKind, WavelengthsKind};
 
 /// Below this many bounded objects the scene tests them one by one instead of
-/// building a BVH over them: a handful of spheres and quads is faster to test
-/// directly than to traverse (see benches/render.rs).
+/// building a BVH over them. Measured with callgrind (instructions for a 32x32,
+/// 4-spp render, one thread): cornell.ron (7 objects) 50.0 M linear vs 57.9 M
+/// with a BVH; spheres.ron (15 objects) 117.1 M linear vs 102.2 M with a BVH.
+/// The crossover lies between, so 8.
 pub const BVH_MIN_OBJECTS: usize = 8;
 
 /// An object: a shape with a material and possibly an emission.
@@ -94,7 +96,7 @@ pub struct Scene {
     light_cdf: Vec<f32>,
     /// The camera.
     pub camera: Camera,
-    /// Render settings from the file (before command-line overrides).
+    /// Render settings: the file's `render` block with command-line overrides applied.
     pub settings: Settings,
     /// Indices of bounded objects, in the BVH's order when there is one.
     bounded: Vec<u32>,
