@@ -1,5 +1,7 @@
 //! Render throughput: samples per second on the committed scenes at 128x128,
-//! on 1 and 2 threads (median of 3 runs each), and the scaling ratio.
+//! on 1 and 2 threads (median of 3 runs each), and the scaling ratio, for
+//! the full-spectrum integrators (`path`, `auto` collapsing to 4 or 8) and
+//! hero packets of 4 and 8 wavelengths.
 //!
 //! `cargo bench --bench render [-- SCENE...]`
 
@@ -32,9 +34,21 @@ fn main() {
         "scene", "integrator", "passes", "1 thread Ms/s", "2 threads Ms/s", "ratio"
     );
     for scene_path in scenes {
-        for integrator in [IntegratorKind::Path, IntegratorKind::Spectral] {
-            let overrides =
-                RenderDesc { width: Some(128), height: Some(128), integrator: Some(integrator), ..Default::default() };
+        let methods = [
+            ("path", IntegratorKind::Path, 4),
+            ("auto", IntegratorKind::Auto, 4),
+            ("auto-8", IntegratorKind::Auto, 8),
+            ("hero-4", IntegratorKind::Spectral, 4),
+            ("hero-8", IntegratorKind::Spectral, 8),
+        ];
+        for (name, integrator, packet) in methods {
+            let overrides = RenderDesc {
+                width: Some(128),
+                height: Some(128),
+                integrator: Some(integrator),
+                packet_size: Some(packet),
+                ..Default::default()
+            };
             let scene = match load_scene(&root.join(&scene_path), &overrides) {
                 Ok(s) => s,
                 Err(e) => {
@@ -68,7 +82,7 @@ fn main() {
             println!(
                 "{:<28} {:>10} {:>8} {:>14.3} {:>14.3} {:>8.2}",
                 scene_path,
-                format!("{integrator:?}").to_lowercase(),
+                name,
                 passes,
                 rates[0],
                 rates[1],
