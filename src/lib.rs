@@ -24,12 +24,15 @@
 pub mod bvh;
 pub mod bxdf;
 pub mod camera;
+pub mod chart;
 pub mod color;
+pub mod converge;
 pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod light;
+pub mod metrics;
 pub mod render;
 pub mod sampler;
 pub mod sampling;
