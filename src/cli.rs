@@ -30,6 +30,65 @@ pub struct Cli {
 pub enum Command {
     /// Render a RON scene file to a 16-bit sRGB PNG (or a linear EXR).
     Render(RenderArgs),
+    /// Compare two images (PNG 8/16-bit or EXR): thesis MSE, PSNR, SSIM, windowed SSIM, linear errors.
+    Compare(CompareArgs),
+    /// Convergence study: render progressively with several methods and seeds, measure
+    /// against a reference at checkpoints, write CSVs and charts.
+    Converge(ConvergeArgs),
+}
+
+/// Flags of `compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The image to measure (PNG or EXR).
+    pub a: PathBuf,
+    /// The reference image (PNG or EXR); relative errors are relative to it.
+    pub b: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Flags of `converge`.
+#[derive(Debug, Args)]
+pub struct ConvergeArgs {
+    /// The scene file (RON).
+    pub scene: PathBuf,
+    /// The reference image (EXR from `rust-v render SCENE -o ref.exr --spp N`, or PNG).
+    /// The render size defaults to the reference's.
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Methods, comma-separated: path, hero, random, whitted, rgb.
+    #[arg(long, value_delimiter = ',', default_value = "path,hero,random")]
+    pub methods: Vec<String>,
+    /// Render each method with this many seeds (the scene's seed, +1, +2, ...) to show the spread.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub seeds: u32,
+    /// Render each method (and seed) for this many seconds, measuring at 1, 2, 4, 8, ... spp.
+    #[arg(long, value_parser = parse_seconds, conflicts_with = "spp_schedule")]
+    pub time: Option<f64>,
+    /// Measure at these sample counts, comma-separated (default: 1, 2, 4, ... up to --spp).
+    #[arg(long, value_delimiter = ',')]
+    pub spp_schedule: Option<Vec<u32>>,
+    /// Directory for the CSVs and charts (default: the current directory).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress lines on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v < 1e9 => Ok(v),
+        _ => Err(format!("'{s}': expected a positive number of seconds")),
+    }
 }
 
 /// Flags of `render`. Settings given here override the scene file's `render` block.
@@ -48,6 +107,10 @@ pub struct RenderArgs {
     /// No progress bar or summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Stop after this many seconds of rendering, in whole passes (no new pass starts
+    /// after it). Without --spp the render runs until the time is up.
+    #[arg(long, value_parser = parse_seconds)]
+    pub time: Option<f64>,
 }
 
 /// Render settings shared by the subcommands that render.
@@ -99,10 +162,12 @@ impl SettingsArgs {
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(args) => render_command(args),
+        Command::Compare(args) => crate::study::compare_command(args),
+        Command::Converge(args) => crate::study::converge_command(args),
     }
 }
 
-fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
+pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
         b = b.num_threads(n as usize);
@@ -140,9 +205,12 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let mut film = Film::new(s.width, s.height);
     let stop = AtomicBool::new(false);
     let pool = thread_pool(args.threads)?;
-    let mut bar = ProgressBar::new(args.quiet);
+    let budget = args.time.map(Duration::from_secs_f64);
+    // With a time budget and no explicit --spp, render until the time is up.
+    let passes = if budget.is_some() && args.settings.spp.is_none() { u32::MAX } else { s.spp };
+    let mut bar = ProgressBar::new(args.quiet, budget);
     let stats = pool.install(|| {
-        render(&scene, &mut film, 0..s.spp, Limits { stop: &stop, time_budget: None }, &mut |_, p| bar.update(p))
+        render(&scene, &mut film, 0..passes, Limits { stop: &stop, time_budget: budget }, &mut |_, p| bar.update(p))
     });
     bar.finish();
     film.write(&output)?;
@@ -180,11 +248,12 @@ fn report(scene: &Scene, stats: &rust_v::render::RenderStats, output: &Path, qui
 struct ProgressBar {
     quiet: bool,
     last: Option<Instant>,
+    budget: Option<Duration>,
 }
 
 impl ProgressBar {
-    fn new(quiet: bool) -> Self {
-        ProgressBar { quiet, last: None }
+    fn new(quiet: bool, budget: Option<Duration>) -> Self {
+        ProgressBar { quiet, last: None, budget }
     }
 
     fn update(&mut self, p: &Progress) {
@@ -195,17 +264,24 @@ impl ProgressBar {
         self.last = Some(Instant::now());
         let secs = p.elapsed.as_secs_f64().max(1e-9);
         let rate = p.passes_this_run as f64 * p.samples_per_pass as f64 / secs;
-        let left = secs / p.passes_this_run as f64 * (p.passes_planned - p.passes_this_run) as f64;
+        let mut left = secs / p.passes_this_run as f64 * (p.passes_planned - p.passes_this_run) as f64;
         let width = 30;
-        let filled = (width as u64 * p.passes_this_run as u64 / p.passes_planned.max(1) as u64) as usize;
+        let mut filled = (width as u64 * p.passes_this_run as u64 / p.passes_planned.max(1) as u64) as usize;
+        if let Some(b) = self.budget {
+            let b = b.as_secs_f64();
+            if b - secs < left {
+                left = (b - secs).max(0.0);
+                filled = ((width as f64 * secs / b) as usize).min(width);
+            }
+        }
         let mut err = std::io::stderr().lock();
         let _ = write!(
             err,
-            "\r[{}{}] pass {}/{}  {:.2} Msamples/s  {:.1} s left   ",
+            "\r[{}{}] pass {}{}  {:.2} Msamples/s  {:.1} s left   ",
             "=".repeat(filled),
             " ".repeat(width - filled),
             p.passes_this_run,
-            p.passes_planned,
+            if p.passes_planned == u32::MAX { String::new() } else { format!("/{}", p.passes_planned) },
             rate / 1e6,
             left
         );

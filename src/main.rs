@@ -1,6 +1,7 @@
 //! The `rust-v` binary: parse the command line, run, print errors, exit.
 
 mod cli;
+mod study;
 
 use clap::Parser;
 

@@ -7,4 +7,5 @@ mod common;
 
 mod cli;
 mod furnace;
+mod metrics;
 mod scenes;
