@@ -49,6 +49,8 @@ pub struct Chart {
     pub log_y: bool,
     /// A horizontal reference line (e.g. 1 for ratios).
     pub y_line: Option<f64>,
+    /// Put the legend at the middle of the right edge instead of the upper right corner.
+    pub legend_middle: bool,
 }
 
 /// The colour of the `i`-th series.
@@ -170,7 +172,7 @@ where
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK.mix(0.4))
         .label_font(("sans-serif", 16))
-        .position(SeriesLabelPosition::UpperRight)
+        .position(if chart.legend_middle { SeriesLabelPosition::MiddleRight } else { SeriesLabelPosition::UpperRight })
         .draw()
         .map_err(err)?;
     Ok(())

@@ -233,7 +233,14 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
             if by_seconds { "render time" } else { "spp" }
         );
         let x_label = if by_seconds { "render time (s)" } else { spp_axis };
-        let c = Chart { title, x_label: x_label.into(), y_label: y_label.into(), log_y, y_line: None };
+        let c = Chart {
+            title,
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            log_y,
+            y_line: None,
+            legend_middle: false,
+        };
         let stem = file(suffix);
         chart::draw(&stem, &c, &series(metric, by_seconds))?;
         written.push(stem.with_extension("png"));
@@ -254,6 +261,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
             y_label: "ratio (eqs. 4.9-4.11, unitless)".into(),
             log_y: false,
             y_line: Some(1.0),
+            legend_middle: true,
         };
         chart::draw(&file("ratios-spp"), &c, &s)?;
         written.push(file("ratios-spp.png"));
