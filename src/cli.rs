@@ -42,6 +42,57 @@ pub enum Command {
     Resume(ResumeArgs),
     /// Sum checkpoints of disjoint pass ranges of one scene into an image or a checkpoint.
     Merge(MergeArgs),
+    /// Compare two images (PNG 8/16-bit or EXR): thesis MSE, PSNR, SSIM, windowed SSIM, linear errors.
+    Compare(CompareArgs),
+    /// Convergence study: render progressively with several methods and seeds, measure
+    /// against a reference at checkpoints, write CSVs and charts.
+    Converge(ConvergeArgs),
+}
+
+/// Flags of `compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The image to measure (PNG or EXR).
+    pub a: PathBuf,
+    /// The reference image (PNG or EXR); relative errors are relative to it.
+    pub b: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Flags of `converge`.
+#[derive(Debug, Args)]
+pub struct ConvergeArgs {
+    /// The scene file (RON).
+    pub scene: PathBuf,
+    /// The reference image (EXR from `rust-v render SCENE -o ref.exr --spp N`, or PNG).
+    /// The render size defaults to the reference's.
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Methods, comma-separated: auto, path, hero, random, whitted, rgb.
+    #[arg(long, value_delimiter = ',', default_value = "path,hero,random")]
+    pub methods: Vec<String>,
+    /// Render each method with this many seeds (the scene's seed, +1, +2, ...) to show the spread.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub seeds: u32,
+    /// Render each method (and seed) for this many seconds, measuring at 1, 2, 4, 8, ... spp.
+    #[arg(long, value_parser = parse_seconds, conflicts_with = "spp_schedule")]
+    pub time: Option<f64>,
+    /// Measure at these sample counts, comma-separated (default: 1, 2, 4, ... up to --spp).
+    #[arg(long, value_delimiter = ',')]
+    pub spp_schedule: Option<Vec<u32>>,
+    /// Directory for the CSVs and charts (default: the current directory).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress lines on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Flags of `render`. Settings given here override the scene file's `render` block.
@@ -65,6 +116,10 @@ pub struct RenderArgs {
     pub passes: Option<Range<u32>>,
     #[command(flatten)]
     pub checkpoint: CheckpointArgs,
+    /// Stop after this many seconds of rendering, in whole passes (no new pass starts
+    /// after it). Without --spp the render runs until the time is up.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub time: Option<f64>,
 }
 
 /// Checkpoint flags shared by `render` and `resume`.
@@ -189,6 +244,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render_command(args),
         Command::Resume(args) => resume_command(args),
         Command::Merge(args) => merge_command(args),
+        Command::Compare(args) => crate::study::compare_command(args),
+        Command::Converge(args) => crate::study::converge_command(args),
     }
 }
 
@@ -230,7 +287,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
             rust_v::integrator::describe(&scene)
         );
     }
-    let passes = args.passes.clone().unwrap_or(0..s.spp);
+    // With a time budget and no --spp (or --passes), render until the time is up.
+    let open_ended = args.time.is_some() && args.settings.spp.is_none() && args.passes.is_none();
+    let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
     let checkpoint = Checkpoint {
         crate_version: env!("CARGO_PKG_VERSION").into(),
@@ -248,6 +307,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         output,
         threads: args.threads,
         quiet: args.quiet,
+        budget: args.time.map(Duration::from_secs_f64),
     };
     session.run(&scene, checkpoint, passes.end, &plan)
 }
@@ -309,6 +369,7 @@ fn resume_command(args: ResumeArgs) -> Result<()> {
         output,
         threads: args.threads,
         quiet: args.quiet,
+        budget: None,
     };
     session.run(&scene, ckpt, end, &plan)
 }
@@ -373,12 +434,13 @@ pub fn report(scene: &Scene, stats: &rust_v::render::RenderStats, output: &Path,
 pub struct ProgressBar {
     quiet: bool,
     last: Option<Instant>,
+    budget: Option<Duration>,
 }
 
 impl ProgressBar {
-    /// A bar that prints nothing when `quiet`.
-    pub fn new(quiet: bool) -> Self {
-        ProgressBar { quiet, last: None }
+    /// A bar that prints nothing when `quiet`; with a time budget, time left counts down to it.
+    pub fn new(quiet: bool, budget: Option<Duration>) -> Self {
+        ProgressBar { quiet, last: None, budget }
     }
 
     /// Redraws the bar (at most every 200 ms, and after the last pass).
@@ -390,17 +452,24 @@ impl ProgressBar {
         self.last = Some(Instant::now());
         let secs = p.elapsed.as_secs_f64().max(1e-9);
         let rate = p.passes_this_run as f64 * p.samples_per_pass as f64 / secs;
-        let left = secs / p.passes_this_run as f64 * (p.passes_planned - p.passes_this_run) as f64;
+        let mut left = secs / p.passes_this_run as f64 * (p.passes_planned - p.passes_this_run) as f64;
         let width = 30;
-        let filled = (width as u64 * p.passes_this_run as u64 / p.passes_planned.max(1) as u64) as usize;
+        let mut filled = (width as u64 * p.passes_this_run as u64 / p.passes_planned.max(1) as u64) as usize;
+        if let Some(b) = self.budget {
+            let b = b.as_secs_f64();
+            if b - secs < left {
+                left = (b - secs).max(0.0);
+                filled = ((width as f64 * secs / b) as usize).min(width);
+            }
+        }
         let mut err = std::io::stderr().lock();
         let _ = write!(
             err,
-            "\r[{}{}] pass {}/{}  {:.2} Msamples/s  {:.1} s left   ",
+            "\r[{}{}] pass {}{}  {:.2} Msamples/s  {:.1} s left   ",
             "=".repeat(filled),
             " ".repeat(width - filled),
             p.passes_this_run,
-            p.passes_planned,
+            if p.passes_planned == u32::MAX { String::new() } else { format!("/{}", p.passes_planned) },
             rate / 1e6,
             left
         );

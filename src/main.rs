@@ -2,6 +2,7 @@
 
 mod cli;
 mod session;
+mod study;
 
 use clap::Parser;
 

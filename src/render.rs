@@ -52,8 +52,10 @@ pub struct RenderStats {
     pub invalid_samples: u64,
     /// Wall time spent rendering.
     pub elapsed: Duration,
-    /// True when the render stopped before its last pass.
+    /// True when the stop flag ended the render before its last pass.
     pub interrupted: bool,
+    /// True when the time budget ended the render before its last pass.
+    pub out_of_time: bool,
 }
 
 /// When to stop a render early.
@@ -104,8 +106,12 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
         let mut stats = RenderStats::default();
         let planned = passes.len() as u32;
         for pass in passes {
-            if limits.stop.load(Ordering::Relaxed) || limits.time_budget.is_some_and(|b| start.elapsed() >= b) {
+            if limits.stop.load(Ordering::Relaxed) {
                 stats.interrupted = true;
+                break;
+            }
+            if limits.time_budget.is_some_and(|b| start.elapsed() >= b) {
+                stats.out_of_time = true;
                 break;
             }
             let results: Vec<Option<Vec<Xyz>>> = tiles

@@ -45,6 +45,8 @@ pub struct SessionPlan {
     pub threads: Option<u32>,
     /// No progress or notes on stderr.
     pub quiet: bool,
+    /// Stop after this much render time, in whole passes (`render --time`).
+    pub budget: Option<Duration>,
 }
 
 /// The signal flags of a running render; dropping it restores default handling.
@@ -84,14 +86,14 @@ impl Session {
         let pool = thread_pool(plan.threads)?;
         let mut film = std::mem::replace(&mut ckpt.film, Film::new(0, 0));
         let start = film.pass_range().end;
-        let mut bar = ProgressBar::new(plan.quiet);
+        let mut bar = ProgressBar::new(plan.quiet, plan.budget);
         let mut last_checkpoint = Instant::now();
         let stats = pool.install(|| {
             render(
                 scene,
                 &mut film,
                 start..end.max(start),
-                Limits { stop: &self.stop, time_budget: None },
+                Limits { stop: &self.stop, time_budget: plan.budget },
                 &mut |film, progress| {
                     bar.update(progress);
                     if self.snapshot.swap(false, Ordering::SeqCst) {

@@ -6,7 +6,9 @@ use crate::common::{rust_v, temp_dir};
 
 /// Runs `render` on a scene text and returns stderr, asserting failure without a panic.
 fn fails_with(scene_text: &str, extra: &[&str]) -> String {
-    let dir = temp_dir(&format!("bad-{:x}", scene_text.len() * 31 + extra.len()));
+    // A fresh folder per call: tests run in parallel threads of one process.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let dir = temp_dir(&format!("bad-{}", CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)));
     let path = dir.join("bad.ron");
     std::fs::write(&path, scene_text).unwrap();
     let out = dir.join("out.png");

@@ -9,5 +9,6 @@ mod auto;
 mod checkpoint;
 mod cli;
 mod furnace;
+mod metrics;
 mod scenes;
 mod spectral;
