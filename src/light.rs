@@ -284,6 +284,61 @@ mod stability_tests {
     use crate::geometry::Ray;
     use crate::sampler::Sampler;
 
+    /// A two-sided sphere light seen from inside is sampled by area: its pdf
+    /// (per solid angle) integrates to 1 over all directions, since every
+    /// direction from inside hits it. Estimated with 200k uniform directions:
+    /// pdf_li · 4π has a relative std. error of ~0.3% here (the pdf varies by
+    /// a factor ~10 over the sphere from this off-centre point), so 2%.
+    /// Also `pdf_li` agrees with the pdf `sample_li` returned, and every
+    /// sampled point lies on the sphere.
+    #[test]
+    fn two_sided_sphere_pdf_by_area_from_inside_integrates_to_one() {
+        let sphere = Sphere::new(Vec3::new(0.2, -0.1, 0.3), 1.5);
+        let light = Light::Sphere { sphere, radiance: Spectrum::ONE, two_sided: true };
+        let p = Vec3::new(0.9, 0.4, -0.2);
+        let mut s = Sampler::new(5, 1, 1);
+        let n = 200_000;
+        let mut integral = 0.0f64;
+        for _ in 0..n {
+            let w = crate::sampling::uniform_sphere(s.next_2d());
+            let h = sphere.intersect(&Ray::new(p, w), f32::INFINITY).expect("from inside every ray hits");
+            integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
+        }
+        let integral = integral / n as f64;
+        assert!((integral - 1.0).abs() < 0.02, "∫pdf = {integral}");
+        for _ in 0..1000 {
+            let ls = light.sample_li(p, s.next_2d()).unwrap();
+            assert!(((ls.point - sphere.center).length() - sphere.radius).abs() < 1e-4);
+            let back = light.pdf_li(p, ls.wi, ls.point);
+            assert!((back - ls.pdf).abs() <= 1e-3 * ls.pdf, "{back} vs {}", ls.pdf);
+        }
+        // A one-sided sphere emits nothing inward: no sample, pdf 0.
+        let one = Light::Sphere { sphere, radiance: Spectrum::ONE, two_sided: false };
+        assert!(one.sample_li(p, Vec2::splat(0.3)).is_none());
+        assert_eq!(one.pdf_li(p, Vec3::X, p + Vec3::X), 0.0);
+    }
+
+    /// A two-sided disk is sampled by area from both sides: the pdf
+    /// integrates to 1 from behind as well (same tolerance as the one-sided test).
+    #[test]
+    fn two_sided_disk_pdf_integrates_to_one_from_both_sides() {
+        let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
+        let light = Light::Disk { disk: disk.clone(), radiance: Spectrum::ONE, two_sided: true };
+        for (seed, p) in [(3, Vec3::new(0.5, 0.0, -0.2)), (4, Vec3::new(-0.3, 1.6, 0.1))] {
+            let mut s = Sampler::new(seed, 1, 1);
+            let n = 200_000;
+            let mut integral = 0.0f64;
+            for _ in 0..n {
+                let w = crate::sampling::uniform_sphere(s.next_2d());
+                if let Some(h) = disk.intersect(&Ray::new(p, w), f32::INFINITY) {
+                    integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
+                }
+            }
+            let integral = integral / n as f64;
+            assert!((integral - 1.0).abs() < 0.04, "from {p}: ∫pdf = {integral}");
+        }
+    }
+
     /// The irradiance from a sphere light of radiance L whose centre is at
     /// distance d along the normal is exactly E = π L (r/d)² (a sphere fully
     /// above the horizon). The next-event estimator Σ L cos θ / pdf must give
