@@ -11,3 +11,4 @@ mod cli;
 mod furnace;
 mod scenes;
 mod spectral;
+mod stability;
