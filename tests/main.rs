@@ -12,3 +12,4 @@ mod furnace;
 mod metrics;
 mod scenes;
 mod spectral;
+mod stability;

@@ -31,7 +31,8 @@ impl Dielectric {
     /// Samples reflection or refraction for index `eta` (inside / outside).
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, uc: f32, eta: f32) -> Option<BsdfSample<N>> {
-        if wo.z == 0.0 {
+        // Below the smallest normal f32, 1 / |cos θ| overflows to infinity.
+        if wo.z.abs() < f32::MIN_POSITIVE {
             return None;
         }
         let r = fresnel_dielectric(wo.z, eta);
@@ -43,7 +44,7 @@ impl Dielectric {
         }
         // Refraction, chosen with probability T = 1 - R.
         let (wi, etap) = refract(wo, Vec3::Z, eta)?;
-        if wi.z == 0.0 {
+        if wi.z.abs() < f32::MIN_POSITIVE {
             return None;
         }
         let f = t / (wi.z.abs() * etap * etap);

@@ -27,6 +27,8 @@ mod ior;
 mod lambertian;
 mod oren_nayar;
 mod specular;
+#[cfg(test)]
+mod tests;
 
 pub use dielectric::Dielectric;
 pub use fresnel::{fresnel_dielectric, refract};

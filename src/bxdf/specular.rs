@@ -23,7 +23,8 @@ impl Mirror {
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Option<BsdfSample<N>> {
         let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-        if wi.z == 0.0 {
+        // Below the smallest normal f32, 1 / |cos θi| overflows to infinity.
+        if wi.z.abs() < f32::MIN_POSITIVE {
             return None;
         }
         Some(BsdfSample {
