@@ -5,7 +5,7 @@
 //! ```sh
 //! cargo run --release --example embree_rays -- \
 //!     [--mesh ../shared/meshes/dragon_vrip.ply.gz] [--data ~/.cache/peers/embree-data] \
-//!     [--kinds primary incoherent] [--passes 5] [--rounds 1] [--no-hits]
+//!     [--kinds primary incoherent] [--passes 5] [--rounds 1] [--no-hits] [--limit N]
 //! ```
 //!
 //! For each kind it reads `DATA/rays/STEM.KIND.rays` (N x 6 little-endian f32: origin,
@@ -15,6 +15,7 @@
 //! result is the hit file), then `--passes` timed passes on this thread: closest hit,
 //! `t` in (0, inf). Reports N / median wall time and N / median thread CPU time (from
 //! `/proc/thread-self/schedstat`, which shows whether the thread was descheduled).
+//! `--limit N` traces only the first N rays (e.g. under valgrind).
 //! Hits go to `DATA/hits/STEM.KIND.rust-v.hits`: per ray f32 t and i32 PLY face index
 //! (`Mesh::face_index`), `inf` and -1 for a miss.
 
@@ -32,7 +33,7 @@ fn main() {
         peers.join("embree-data")
     });
     let mut kinds = vec!["primary".to_string(), "incoherent".to_string()];
-    let (mut passes, mut rounds, mut write_hits) = (5usize, 1usize, true);
+    let (mut passes, mut rounds, mut write_hits, mut limit) = (5usize, 1usize, true, usize::MAX);
     let mut args = std::env::args().skip(1).peekable();
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -41,6 +42,7 @@ fn main() {
             "--passes" => passes = args.next().and_then(|s| s.parse().ok()).expect("--passes N"),
             "--rounds" => rounds = args.next().and_then(|s| s.parse().ok()).expect("--rounds N"),
             "--no-hits" => write_hits = false,
+            "--limit" => limit = args.next().and_then(|s| s.parse().ok()).expect("--limit N"),
             "--kinds" => {
                 kinds.clear();
                 while let Some(k) = args.next_if(|s| !s.starts_with("--")) {
@@ -86,8 +88,11 @@ fn main() {
             }
         }
         let f: Vec<f32> = raw.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-        let rays: Vec<Ray> =
-            f.chunks_exact(6).map(|r| Ray::new(Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5]))).collect();
+        let rays: Vec<Ray> = f
+            .chunks_exact(6)
+            .map(|r| Ray::new(Vec3::new(r[0], r[1], r[2]), Vec3::new(r[3], r[4], r[5])))
+            .take(limit)
+            .collect();
         let nr = rays.len();
 
         // Warm-up pass: its hits are the hit file.
