@@ -56,7 +56,8 @@ pub struct Mesh {
     /// Unit per-vertex normals, if the file had them.
     normals: Option<Vec<Vec3>>,
     bvh: Bvh,
-    degenerate: usize,
+    /// Input triangle indices of the dropped zero-area triangles, ascending.
+    dropped: Vec<u32>,
 }
 
 /// Barycentric payload of a mesh hit, turned into a [`Hit`] once the closest is known.
@@ -74,29 +75,17 @@ impl Mesh {
     /// with no valid triangle, an out-of-range index, a non-finite coordinate or a
     /// singular transform is an error naming the file.
     pub fn load(path: &Path, transform: &Transform) -> Result<Mesh> {
-        let raw = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-        let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
-        let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
-            let mut out = Vec::with_capacity(raw.len() * 4);
-            flate2::read::MultiGzDecoder::new(raw.as_slice())
-                .read_to_end(&mut out)
-                .map_err(|e| Error::mesh(path, format!("gzip decompression failed: {e}")))?;
-            (out, stem.to_string())
-        } else {
-            (raw, name)
-        };
-        let (positions, indices, normals) = if name.ends_with(".ply") {
-            let d = ply::parse(&data, path)?;
-            (d.positions, d.triangles, d.normals)
-        } else if name.ends_with(".obj") {
-            load_obj(&data, path)?
-        } else {
-            return Err(Error::mesh(
-                path,
-                "unknown mesh format: expected a name ending in .obj, .ply, .obj.gz or .ply.gz",
-            ));
-        };
+        let (positions, indices, normals) = read_file(path)?;
         Mesh::build(positions, indices, normals, transform, &|m| Error::mesh(path, m))
+    }
+
+    /// The raw contents of a mesh file as [`Mesh::load`] reads them, before any transform
+    /// or filtering: vertex positions and triangles (vertex indices; polygons
+    /// fan-triangulated, OBJ triangulated by tobj) in file order, degenerate triangles
+    /// included. Triangle `i` here is what [`Mesh::face_index`] refers to.
+    pub fn read_arrays(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>)> {
+        let (positions, indices, _) = read_file(path)?;
+        Ok((positions, indices))
     }
 
     /// A mesh from positions, triangles (indices into `positions`, counter-clockwise
@@ -139,7 +128,7 @@ impl Mesh {
         let mirror = det < 0.0;
         let nv = positions.len();
         let mut kept: Vec<[u32; 3]> = Vec::with_capacity(indices.len());
-        let mut degenerate = 0;
+        let mut dropped = Vec::new();
         for (f, tri) in indices.iter().enumerate() {
             if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
                 return Err(err(format!("triangle {f}: vertex index {bad} out of range (there are {nv} vertices)")));
@@ -150,11 +139,11 @@ impl Mesh {
             if area2 > 0.0 && area2.is_finite() {
                 kept.push(tri);
             } else {
-                degenerate += 1;
+                dropped.push(f as u32);
             }
         }
         if kept.is_empty() {
-            return Err(err(format!("no valid triangles ({} given, {degenerate} of zero area)", indices.len())));
+            return Err(err(format!("no valid triangles ({} given, {} of zero area)", indices.len(), dropped.len())));
         }
         let bounds: Vec<Aabb> = kept
             .iter()
@@ -167,7 +156,7 @@ impl Mesh {
         let order = bvh.prim_order();
         let tris = order.iter().map(|&i| kept[i as usize].map(|v| positions[v as usize])).collect();
         let normal_idx = if normals.is_some() { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
-        Ok(Mesh { tris, normal_idx, normals, bvh, degenerate })
+        Ok(Mesh { tris, normal_idx, normals, bvh, dropped })
     }
 
     /// Closest hit with `0 < t < t_max`. `prim` is the triangle's index in storage order.
@@ -220,7 +209,7 @@ impl Mesh {
 
     /// Number of zero-area triangles dropped at load.
     pub fn degenerate_dropped(&self) -> usize {
-        self.degenerate
+        self.dropped.len()
     }
 
     /// The mesh's BVH (its slots are the triangle indices of [`Mesh::triangle`]).
@@ -239,9 +228,48 @@ impl Mesh {
         self.bvh.prim_order()[prim as usize]
     }
 
+    /// Index of triangle `prim` (storage order) in the input triangle list, counting the
+    /// zero-area triangles that were dropped: for a PLY file of triangles this is the
+    /// face index in file order (polygons count one per fan triangle), the primitive id
+    /// other tracers such as Embree report for the same file.
+    pub fn face_index(&self, prim: u32) -> u32 {
+        let mut f = self.original_index(prim);
+        // Each dropped triangle at or before the running index shifts it by one.
+        for &d in &self.dropped {
+            if d > f {
+                break;
+            }
+            f += 1;
+        }
+        f
+    }
+
     /// True if the mesh has per-vertex normals.
     pub fn has_normals(&self) -> bool {
         self.normals.is_some()
+    }
+}
+
+/// Reads and decompresses a mesh file into positions, triangles and optional normals.
+fn read_file(path: &Path) -> Result<Loaded> {
+    let raw = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
+    let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
+        let mut out = Vec::with_capacity(raw.len() * 4);
+        flate2::read::MultiGzDecoder::new(raw.as_slice())
+            .read_to_end(&mut out)
+            .map_err(|e| Error::mesh(path, format!("gzip decompression failed: {e}")))?;
+        (out, stem.to_string())
+    } else {
+        (raw, name)
+    };
+    if name.ends_with(".ply") {
+        let d = ply::parse(&data, path)?;
+        Ok((d.positions, d.triangles, d.normals))
+    } else if name.ends_with(".obj") {
+        load_obj(&data, path)
+    } else {
+        Err(Error::mesh(path, "unknown mesh format: expected a name ending in .obj, .ply, .obj.gz or .ply.gz"))
     }
 }
 
@@ -471,6 +499,26 @@ mod tests {
         println!("dragon res4: {} triangles, {} degenerate dropped", m.triangle_count(), m.degenerate_dropped());
         assert_eq!(m.triangle_count() + m.degenerate_dropped(), 11_102);
         check_against_brute_force(&m, 10_000, 2);
+    }
+
+    #[test]
+    fn face_index_counts_dropped_triangles() {
+        let pos: Vec<Vec3> = (0..12).map(|i| Vec3::new(i as f32, (i * i % 7) as f32, (i % 3) as f32)).collect();
+        // Faces 0, 3, 4 and 7 are degenerate (repeated vertex).
+        let faces: Vec<[u32; 3]> = (0..9u32)
+            .map(|f| if [0, 3, 4, 7].contains(&f) { [f, f, f + 1] } else { [f, f + 1, f + 2 + (f % 2)] })
+            .collect();
+        let m = Mesh::from_triangles(pos.clone(), faces.clone(), None).unwrap();
+        assert_eq!(m.degenerate_dropped(), 4);
+        let mut seen: Vec<u32> = (0..m.triangle_count() as u32)
+            .map(|k| {
+                let f = m.face_index(k);
+                assert_eq!(m.triangle(k), faces[f as usize].map(|i| pos[i as usize]), "slot {k} -> face {f}");
+                f
+            })
+            .collect();
+        seen.sort();
+        assert_eq!(seen, vec![1, 2, 5, 6, 8]);
     }
 
     #[test]
