@@ -196,6 +196,17 @@ impl<const N: usize> Lambdas<N> {
     /// The colour of a packet of radiance values.
     pub fn to_xyz(&self, l: &Sampled<N>) -> Xyz {
         match self.readout {
+            Readout::Spectral if N == N_BINS => {
+                // The identity packet (the full spectrum): bin i is value i, no
+                // index conversion (this runs once per camera sample).
+                let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
+                for (v, w) in l.0.iter().zip(&color::cie::CMF_NORMALISED) {
+                    x += v * w[0];
+                    y += v * w[1];
+                    z += v * w[2];
+                }
+                Xyz::new(x * self.weight, y * self.weight, z * self.weight)
+            }
             Readout::Spectral => {
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
                 for i in 0..N {
