@@ -114,7 +114,7 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
                 stats.out_of_time = true;
                 break;
             }
-            let results: Vec<Option<Vec<Xyz>>> = tiles
+            let results: Option<Vec<Vec<Xyz>>> = tiles
                 .par_iter()
                 .map(|tile| {
                     if limits.stop.load(Ordering::Relaxed) {
@@ -123,13 +123,11 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
                     Some(render_tile(scene, estimator, film.width(), tile, pass))
                 })
                 .collect();
-            if results.iter().any(Option::is_none) {
+            let Some(results) = results else {
                 stats.interrupted = true;
                 break;
-            }
-            for (tile, samples) in tiles.iter().zip(results) {
-                stats.invalid_samples += film.add_tile(tile, &samples.unwrap_or_default()) as u64;
-            }
+            };
+            stats.invalid_samples += film.add_tiles_parallel(&tiles, &results, TILE_SIZE) as u64;
             film.end_pass();
             stats.passes += 1;
             let progress = Progress {
