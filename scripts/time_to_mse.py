@@ -61,18 +61,19 @@ def main():
             print(f"| {m} | " + " | ".join(cells) + " |")
         if "hero" in rows and "random" in rows:
             h, rr = rows["hero"], rows["random"]
-            last = h[-1]
-            ratio_spp = float(last[metric + "_median"]) / float(rr[-1][metric + "_median"])
-            # random's error at hero's time: interpolate random's metric at hero's seconds.
-            th = float(last["seconds_median"])
-            pts = [(float(r["seconds_median"]), float(r[metric + "_median"])) for r in rr]
-            mr = None
-            for (t0, m0), (t1, m1) in zip(pts, pts[1:]):
-                if t0 <= th <= t1:
-                    f = (math.log(th) - math.log(t0)) / (math.log(t1) - math.log(t0))
-                    mr = math.exp(math.log(m0) + f * (math.log(m1) - math.log(m0)))
-            eq_time = f"{float(last[metric + '_median']) / mr:.3f}" if mr else "-"
-            print(f"hero/random {metric} at {last['spp']} spp: {ratio_spp:.3f}; at equal time ({th:.1f} s): {eq_time}")
+            ratio_spp = float(h[-1][metric + "_median"]) / float(rr[-1][metric + "_median"])
+            # Equal time: both curves interpolated (log-log) at the shorter of the two total times.
+            def metric_at(rows_, t):
+                pts = [(float(r["seconds_median"]), float(r[metric + "_median"])) for r in rows_]
+                for (t0, m0), (t1, m1) in zip(pts, pts[1:]):
+                    if t0 <= t <= t1 and t0 > 0:
+                        f = (math.log(t) - math.log(t0)) / (math.log(t1) - math.log(t0))
+                        return math.exp(math.log(m0) + f * (math.log(m1) - math.log(m0)))
+                return None
+            t = min(float(h[-1]["seconds_median"]), float(rr[-1]["seconds_median"]))
+            mh, mr = metric_at(h, t), metric_at(rr, t)
+            eq_time = f"{mh / mr:.3f}" if mh and mr else "-"
+            print(f"hero/random {metric} at {h[-1]['spp']} spp: {ratio_spp:.3f}; at equal time ({t:.1f} s): {eq_time}")
         print()
 
 main()
