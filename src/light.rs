@@ -222,8 +222,22 @@ fn cone_one_minus_cos(sin2_max: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Ray;
+    use crate::geometry::{Hit, Ray};
     use crate::sampler::Sampler;
+
+    /// ∫ pdf_li dω over all directions from `p`, estimated with `n` uniform
+    /// directions; `hit` intersects the light's shape.
+    pub(super) fn pdf_integral(light: &Light, hit: impl Fn(&Ray) -> Option<Hit>, p: Vec3, seed: u64, n: usize) -> f64 {
+        let mut s = Sampler::new(seed, 1, 1);
+        let mut integral = 0.0f64;
+        for _ in 0..n {
+            let w = crate::sampling::uniform_sphere(s.next_2d());
+            if let Some(h) = hit(&Ray::new(p, w)) {
+                integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
+            }
+        }
+        integral / n as f64
+    }
 
     /// The sphere light's pdf integrates to 1 over directions: estimate
     /// ∫ pdf_li dω over the sphere of directions by uniform sphere sampling
@@ -237,17 +251,9 @@ mod tests {
             two_sided: false,
         };
         let p = Vec3::new(0.3, 0.0, 0.1);
-        let mut s = Sampler::new(1, 1, 1);
-        let n = 200_000;
-        let mut integral = 0.0f64;
-        for _ in 0..n {
-            let w = crate::sampling::uniform_sphere(s.next_2d());
-            let hit = Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5).intersect(&Ray::new(p, w), f32::INFINITY);
-            if let Some(h) = hit {
-                integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
-            }
-        }
-        let integral = integral / n as f64;
+        let shape = Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5);
+        let integral = pdf_integral(&light, |r| shape.intersect(r, f32::INFINITY), p, 1, 200_000);
+        let mut s = Sampler::new(1, 2, 1);
         assert!((integral - 1.0).abs() < 0.04, "∫pdf = {integral}");
         for _ in 0..1000 {
             let ls = light.sample_li(p, s.next_2d()).unwrap();
@@ -262,16 +268,7 @@ mod tests {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
         let light = Light::Disk { disk: disk.clone(), radiance: Spectrum::ONE, two_sided: false };
         let p = Vec3::new(0.5, 0.0, -0.2);
-        let mut s = Sampler::new(2, 1, 1);
-        let n = 200_000;
-        let mut integral = 0.0f64;
-        for _ in 0..n {
-            let w = crate::sampling::uniform_sphere(s.next_2d());
-            if let Some(h) = disk.intersect(&Ray::new(p, w), f32::INFINITY) {
-                integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
-            }
-        }
-        let integral = integral / n as f64;
+        let integral = pdf_integral(&light, |r| disk.intersect(r, f32::INFINITY), p, 2, 200_000);
         assert!((integral - 1.0).abs() < 0.04, "∫pdf = {integral}");
         // From behind, the disk is dark and never sampled.
         assert!(light.sample_li(Vec3::new(0.0, 2.0, 0.0), Vec2::splat(0.5)).is_none());
@@ -281,7 +278,6 @@ mod tests {
 #[cfg(test)]
 mod stability_tests {
     use super::*;
-    use crate::geometry::Ray;
     use crate::sampler::Sampler;
 
     /// A two-sided sphere light seen from inside is sampled by area: its pdf
@@ -296,16 +292,10 @@ mod stability_tests {
         let sphere = Sphere::new(Vec3::new(0.2, -0.1, 0.3), 1.5);
         let light = Light::Sphere { sphere, radiance: Spectrum::ONE, two_sided: true };
         let p = Vec3::new(0.9, 0.4, -0.2);
-        let mut s = Sampler::new(5, 1, 1);
-        let n = 200_000;
-        let mut integral = 0.0f64;
-        for _ in 0..n {
-            let w = crate::sampling::uniform_sphere(s.next_2d());
-            let h = sphere.intersect(&Ray::new(p, w), f32::INFINITY).expect("from inside every ray hits");
-            integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
-        }
-        let integral = integral / n as f64;
+        // From inside every direction hits the sphere.
+        let integral = super::tests::pdf_integral(&light, |r| sphere.intersect(r, f32::INFINITY), p, 5, 200_000);
         assert!((integral - 1.0).abs() < 0.02, "∫pdf = {integral}");
+        let mut s = Sampler::new(5, 2, 1);
         for _ in 0..1000 {
             let ls = light.sample_li(p, s.next_2d()).unwrap();
             assert!(((ls.point - sphere.center).length() - sphere.radius).abs() < 1e-4);
@@ -325,16 +315,7 @@ mod stability_tests {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
         let light = Light::Disk { disk: disk.clone(), radiance: Spectrum::ONE, two_sided: true };
         for (seed, p) in [(3, Vec3::new(0.5, 0.0, -0.2)), (4, Vec3::new(-0.3, 1.6, 0.1))] {
-            let mut s = Sampler::new(seed, 1, 1);
-            let n = 200_000;
-            let mut integral = 0.0f64;
-            for _ in 0..n {
-                let w = crate::sampling::uniform_sphere(s.next_2d());
-                if let Some(h) = disk.intersect(&Ray::new(p, w), f32::INFINITY) {
-                    integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
-                }
-            }
-            let integral = integral / n as f64;
+            let integral = super::tests::pdf_integral(&light, |r| disk.intersect(r, f32::INFINITY), p, seed, 200_000);
             assert!((integral - 1.0).abs() < 0.04, "from {p}: ∫pdf = {integral}");
         }
     }
