@@ -2,12 +2,15 @@
 //!
 //! A pass adds one sample to every pixel (thesis §3.6). Within a pass, rayon
 //! renders the tiles in parallel; each tile's samples are computed into a
-//! buffer of its own and added to the film after the pass, in tile order.
+//! buffer of its own and added to the film after the pass (each pixel gets
+//! exactly one sample per pass, so the order of tiles does not matter).
 //! Sample `k` of pixel `p` draws its random numbers from the stream
 //! `(seed, p, k)` ([`crate::sampler`]), so the image is bit-identical for any
 //! thread count or tile order, and a render of passes `a..b` is exactly the
 //! corresponding part of a longer render. No locks or atomics are touched
-//! per sample; allocation is one buffer per tile per pass.
+//! per sample (one relaxed load of the stop flag per tile); allocation is one
+//! buffer per tile per pass. After a pass, bands of tile rows are added to the
+//! film in parallel.
 //!
 //! A render stops early, between tiles, when its `stop` flag is set: the
 //! unfinished pass is discarded, so the film always holds whole passes.

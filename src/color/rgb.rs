@@ -3,7 +3,7 @@
 //! The XYZ <-> linear sRGB matrices are the ones Mitsuba 3 uses (IEC 61966-2-1 / Rec. 709
 //! primaries, D65 white, no chromatic adaptation), so images are directly comparable with the
 //! Mitsuba reference renders. The transfer curve is the IEC 61966-2-1 piecewise sRGB curve.
-//! The film accumulates XYZ in f64, hence the f64 conversion [`xyz_to_linear_srgb_f64`].
+//! The film turns its exact sums into f64 means, hence the f64 conversion [`xyz_to_linear_srgb_f64`].
 
 use core::ops::{Add, AddAssign, Div, Mul, Sub};
 
@@ -182,8 +182,8 @@ pub fn srgb_eotf(encoded: f32) -> f32 {
     if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
 }
 
-/// XYZ -> linear sRGB in f64 (same matrix as [`Xyz::to_linear_srgb`]), for the film, which
-/// accumulates XYZ sums in f64.
+/// XYZ -> linear sRGB in f64 (same matrix as [`Xyz::to_linear_srgb`]), for the film, whose
+/// per-pixel means are f64.
 #[inline]
 pub fn xyz_to_linear_srgb_f64(xyz: [f64; 3]) -> [f64; 3] {
     let m = &XYZ_TO_LINEAR_SRGB;
