@@ -158,6 +158,10 @@ pub struct ResumeArgs {
     /// Write a checkpoint every SECONDS (between passes).
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub checkpoint_every: Option<f64>,
+    /// Resume even if the scene file changed since the checkpoint was written (the
+    /// image then mixes passes of two scenes; the new checkpoint records the new scene).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Flags of `merge`.
@@ -336,11 +340,18 @@ fn resume_command(args: ResumeArgs) -> Result<()> {
     check_output_extension(&output)?;
     let scene = load_scene(&ckpt.scene_path, &ckpt.overrides())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
+    if scene.content_hash != ckpt.content_hash && args.force {
+        eprintln!(
+            "rust-v: warning: {} changed since the checkpoint was written; resuming anyway (--force)",
+            ckpt.scene_path.display()
+        );
+        ckpt.content_hash = scene.content_hash;
+    }
     if scene.content_hash != ckpt.content_hash {
         return Err(Error::checkpoint(
             path,
             format!(
-                "the scene file {} changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same scene",
+                "the scene file {} changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same scene (or --force)",
                 ckpt.scene_path.display(),
                 scene.content_hash,
                 ckpt.content_hash

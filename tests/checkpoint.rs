@@ -124,6 +124,11 @@ fn resume_refuses_a_changed_or_missing_scene() {
     std::fs::write(&scene, text.replace("radius: 0.35", "radius: 0.36")).unwrap();
     let err = fails(&rust_v(&["resume", s(&dir.join("a.ckpt")), "--spp", "2"]));
     assert!(err.contains("a.ckpt") && err.contains("box.ron") && err.contains("changed"), "{err}");
+    // --force resumes anyway, with a warning, and records the new scene.
+    let forced = rust_v(&["resume", s(&dir.join("a.ckpt")), "--spp", "2", "--force", "-o", s(&dir.join("f.png"))]);
+    ok(&forced);
+    assert!(String::from_utf8_lossy(&forced.stderr).contains("--force"));
+    assert!(dir.join("f.png").exists());
     std::fs::remove_file(&scene).unwrap();
     let err = fails(&rust_v(&["resume", s(&dir.join("a.ckpt")), "--spp", "2"]));
     assert!(err.contains("a.ckpt") && err.contains("box.ron"), "{err}");
@@ -310,6 +315,26 @@ mod signals {
             image::open(&p).expect("every snapshot is a valid PNG");
         }
         no_temporaries(&dir);
+    }
+
+    /// SIGKILL at 20 varied moments of renders that rewrite their checkpoint
+    /// after every pass: whatever the moment, the checkpoint on disk loads
+    /// (temporary file, fsync, rename), at worst leaving a stale temporary.
+    #[test]
+    fn sigkill_during_checkpoint_writes_never_breaks_the_checkpoint() {
+        let dir = temp_dir("sigkill");
+        let ckpt = dir.join("k.ckpt");
+        for i in 0..20u64 {
+            let mut child = start(&dir, &["--checkpoint", s(&ckpt), "--checkpoint-every", "0.001"]);
+            if i == 0 {
+                assert!(wait_for(LONG, || ckpt.exists()), "no checkpoint");
+            }
+            std::thread::sleep(Duration::from_millis(2 + 9 * (i % 8)));
+            kill("-KILL", &child);
+            let _ = child.wait();
+            let c = Checkpoint::read(&ckpt).unwrap_or_else(|e| panic!("after kill {i}: {e}"));
+            assert!(c.film.passes() > 0);
+        }
     }
 
     #[test]
