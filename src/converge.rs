@@ -163,7 +163,7 @@ pub fn run(
 }
 
 /// The header of the records CSV.
-pub const CSV_HEADER: &str = "scene,method,seed,passes,spp,seconds,mse,psnr,ssim,ssim_windowed,variance,mse_lin,psnr_lin,relmse,rel_err_luminance,rel_err_r,rel_err_g,rel_err_b";
+pub const CSV_HEADER: &str = "scene,method,seed,passes,spp,seconds,mse,psnr,ssim,ssim_windowed,variance,mse_lin,psnr_lin,relmse,rel_err_luminance,rel_err_r,rel_err_g,rel_err_b,firefly";
 
 /// Writes the records as CSV (with [`CSV_HEADER`]).
 pub fn write_records(path: &Path, scene: &str, records: &[Record]) -> Result<()> {
@@ -173,7 +173,7 @@ pub fn write_records(path: &Path, scene: &str, records: &[Record]) -> Result<()>
         let m = &r.metrics;
         let _ = writeln!(
             s,
-            "{scene},{},{},{},{},{:.6},{:.6e},{:.6},{:.8},{:.8},{:.6e},{:.6e},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}",
+            "{scene},{},{},{},{},{:.6},{:.6e},{:.6},{:.8},{:.8},{:.6e},{:.6e},{:.6},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}",
             r.method,
             r.seed,
             r.passes,
@@ -190,7 +190,8 @@ pub fn write_records(path: &Path, scene: &str, records: &[Record]) -> Result<()>
             m.rel_err_luminance,
             m.rel_err_rgb[0],
             m.rel_err_rgb[1],
-            m.rel_err_rgb[2]
+            m.rel_err_rgb[2],
+            m.firefly
         );
     }
     std::fs::write(path, s).map_err(|e| Error::io(path, e))
@@ -222,7 +223,8 @@ impl Spread {
 }
 
 /// The metrics that are summarised and charted, with their CSV names.
-pub const SUMMARY_METRICS: &[&str] = &["mse", "psnr", "ssim", "ssim_windowed", "variance", "mse_lin", "relmse"];
+pub const SUMMARY_METRICS: &[&str] =
+    &["mse", "psnr", "ssim", "ssim_windowed", "variance", "mse_lin", "relmse", "firefly"];
 
 /// The value of a metric by its CSV name ([`SUMMARY_METRICS`]).
 pub fn metric_value(m: &Metrics, name: &str) -> f64 {
@@ -234,6 +236,7 @@ pub fn metric_value(m: &Metrics, name: &str) -> f64 {
         "variance" => m.variance,
         "mse_lin" => m.mse_lin,
         "relmse" => m.relmse,
+        "firefly" => m.firefly,
         _ => f64::NAN,
     }
 }
@@ -284,6 +287,7 @@ pub fn summarise(records: &[Record]) -> Vec<Summary> {
                 relmse: med(&|m| m.relmse),
                 rel_err_luminance: med(&|m| m.rel_err_luminance),
                 rel_err_rgb: [0, 1, 2].map(|c| med(&|m| m.rel_err_rgb[c])),
+                firefly: med(&|m| m.firefly),
             };
             out.push(Summary {
                 method: m.into(),

@@ -144,6 +144,8 @@ pub struct Metrics {
     pub rel_err_luminance: f64,
     /// `|mean_A - mean_B| / mean_B` of each linear channel (R, G, B).
     pub rel_err_rgb: [f64; 3],
+    /// Firefly share of the image (not the reference): [`firefly_share`] of its linear values.
+    pub firefly: f64,
 }
 
 /// All metrics of `img` against `reference`. Errors when the sizes differ.
@@ -170,7 +172,29 @@ pub fn measure(img: &Image, reference: &Image) -> Result<Metrics> {
         relmse: relmse(&img.linear, &reference.linear),
         rel_err_luminance: relative_error(lum(mean_a), lum(mean_b)),
         rel_err_rgb: [0, 1, 2].map(|c| relative_error(mean_a[c], mean_b[c])),
+        firefly: firefly_share(&img.linear),
     })
+}
+
+/// The fraction of pixels counted as fireflies by [`firefly_share`] (0.1%).
+pub const FIREFLY_FRACTION: f64 = 0.001;
+
+/// The firefly measure: the share of the image's total linear luminance
+/// (`Y = 0.2126 R + 0.7152 G + 0.0722 B`, [`LUMINANCE`]) held by its brightest 0.1%
+/// of pixels ([`FIREFLY_FRACTION`]), at least one pixel: `k = max(1, ceil(0.001 n))`
+/// pixels of `n`. Negative luminances count as 0. It is between `k / n` (a uniform
+/// image) and 1 (all energy in `k` pixels); a converged, smooth image sits near
+/// `k / n`, and a few fireflies push it up. NaN for an image without energy.
+pub fn firefly_share(linear: &[[f64; 3]]) -> f64 {
+    let mut y: Vec<f64> =
+        linear.iter().map(|p| (LUMINANCE[0] * p[0] + LUMINANCE[1] * p[1] + LUMINANCE[2] * p[2]).max(0.0)).collect();
+    let total: f64 = y.iter().sum();
+    if y.is_empty() || !(total > 0.0) {
+        return f64::NAN;
+    }
+    let k = ((FIREFLY_FRACTION * y.len() as f64).ceil() as usize).clamp(1, y.len());
+    y.sort_unstable_by(|a, b| b.total_cmp(a));
+    y[..k].iter().sum::<f64>() / total
 }
 
 /// Rec. 709 / sRGB luminance weights (the Y row of the linear sRGB to XYZ matrix).
@@ -378,6 +402,26 @@ mod tests {
         assert!((mse_linear(&a, &b) - 0.02 / 3.0).abs() < 1e-15);
         let r = (0.01 / (0.16 + 0.01) + 0.0 + 0.01 / (0.01 + 0.01)) / 3.0;
         assert!((relmse(&a, &b) - r).abs() < 1e-15);
+    }
+
+    #[test]
+    fn firefly_share_by_hand() {
+        // 10 pixels: one is k = max(1, ceil(0.01)) = 1 pixel. Grey pixels have Y = value.
+        let mut p = constant(10, [1.0, 1.0, 1.0]);
+        assert!((firefly_share(&p) - 0.1).abs() < 1e-12);
+        p[3] = [11.0, 11.0, 11.0]; // total 9 + 11 = 20, brightest 11
+        assert!((firefly_share(&p) - 0.55).abs() < 1e-12);
+        // Pure red: Y = 0.2126 R; the ratio is unchanged by the weight.
+        p[3] = [11.0, 0.0, 0.0];
+        let y = 0.2126 * 11.0;
+        assert!((firefly_share(&p) - y / (9.0 + y)).abs() < 1e-12);
+        // 2001 pixels: k = ceil(2.001) = 3 brightest (5, 4, 3) of a total 1998 + 12.
+        let mut q = constant(2001, [1.0; 3]);
+        q[0] = [5.0; 3];
+        q[1] = [4.0; 3];
+        q[2] = [3.0; 3];
+        assert!((firefly_share(&q) - 12.0 / 2010.0).abs() < 1e-12);
+        assert!(firefly_share(&constant(4, [0.0; 3])).is_nan());
     }
 
     #[test]

@@ -11,7 +11,7 @@ use std::time::Duration;
 use rust_v::chart::{self, Chart, Series};
 use rust_v::converge::{self, Method, Record, SUMMARY_METRICS, Schedule, Summary};
 use rust_v::error::{Error, Result};
-use rust_v::metrics::{Image, Metrics, Source, THESIS_L, measure};
+use rust_v::metrics::{Image, Metrics, Source, THESIS_L, firefly_share, measure};
 use rust_v::scene::load_scene;
 
 use crate::cli::{CompareArgs, ConvergeArgs, thread_pool};
@@ -81,6 +81,8 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             ("rel_err_r", m.rel_err_rgb[0]),
             ("rel_err_g", m.rel_err_rgb[1]),
             ("rel_err_b", m.rel_err_rgb[2]),
+            ("firefly", m.firefly),
+            ("firefly_b", firefly_share(&ib.linear)),
         ];
         let mut s = format!(
             "{{\"a\": {}, \"b\": {}, \"width\": {}, \"height\": {}, \"a_source\": \"{}\", \"b_source\": \"{}\", \"l\": {}",
@@ -119,6 +121,11 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
     println!(
         "  mean relative error |mean_A - mean_B| / mean_B: luminance {:.4e}, R {:.4e}, G {:.4e}, B {:.4e}",
         m.rel_err_luminance, m.rel_err_rgb[0], m.rel_err_rgb[1], m.rel_err_rgb[2]
+    );
+    println!(
+        "  firefly share {:.4e} (reference {:.4e})   (share of total luminance in the brightest 0.1% of pixels)",
+        m.firefly,
+        firefly_share(&ib.linear)
     );
     Ok(())
 }

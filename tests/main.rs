@@ -9,6 +9,7 @@ mod auto;
 mod checkpoint;
 mod cli;
 mod furnace;
+mod fuzz;
 mod metrics;
 mod scenes;
 mod spectral;

@@ -280,8 +280,13 @@ type Loaded = (Vec<Vec3>, Vec<[u32; 3]>, Option<Vec<Vec3>>);
 fn load_obj(data: &[u8], path: &Path) -> Result<Loaded> {
     let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let mut reader = std::io::BufReader::new(data);
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
-        .map_err(|e| Error::mesh(path, format!("OBJ parse error: {e}")))?;
+    // tobj multiplies face indices without overflow checks: a huge index (e.g. a
+    // relative -2147483649) panics in builds with overflow checks. Turn that into an error.
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
+    }))
+    .map_err(|_| Error::mesh(path, "OBJ parse error: index out of range (the OBJ parser panicked)"))?;
+    let (models, _materials) = parsed.map_err(|e| Error::mesh(path, format!("OBJ parse error: {e}")))?;
     let mut positions = Vec::new();
     let mut indices = Vec::new();
     let mut normals = Vec::new();

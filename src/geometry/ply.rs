@@ -121,10 +121,13 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
         }
     }
     let layout = Layout { xyz, normal, face_list };
+    // The header can claim any count: reserve no more than the body can hold (every
+    // element takes at least one byte), or a corrupt count aborts on allocation.
+    let (nv, nf) = (ve.count.min(body.len()), fe.count.min(body.len()));
     let mut out = PlyData {
-        positions: Vec::with_capacity(ve.count),
-        triangles: Vec::with_capacity(fe.count * 2),
-        normals: normal.map(|_| Vec::with_capacity(ve.count)),
+        positions: Vec::with_capacity(nv),
+        triangles: Vec::with_capacity(nf * 2),
+        normals: normal.map(|_| Vec::with_capacity(nv)),
     };
     match format {
         Format::Ascii => read_ascii(body, header_lines, &elements, vi, fi, &layout, &mut out, path)?,

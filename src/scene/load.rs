@@ -16,6 +16,11 @@ use crate::error::{Error, Result};
 use crate::geometry::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
 use crate::light::Light;
 
+/// The largest coordinate or size a scene may give: squares and products of a few
+/// such numbers must stay finite in f32 (max 3.4e38), or intersections and light
+/// falloff turn into NaN.
+pub const MAX_MAGNITUDE: f32 = 1e15;
+
 /// Loads the scene file at `path`; `overrides` (from the command line) take
 /// precedence over the file's `render` settings.
 pub fn load_scene(path: &Path, overrides: &RenderDesc) -> Result<Scene> {
@@ -57,16 +62,20 @@ impl Ctx<'_> {
     }
 
     fn positive(&self, field: &str, v: f32) -> Result<f32> {
-        if v.is_finite() && v > 0.0 {
+        if v.is_finite() && v > 0.0 && v <= MAX_MAGNITUDE {
             Ok(v)
         } else {
-            Err(self.err(field, format!("expected a positive number, found {v}")))
+            Err(self.err(field, format!("expected a positive number up to {MAX_MAGNITUDE:e}, found {v}")))
         }
     }
 
     fn vec(&self, field: &str, v: V3) -> Result<Vec3> {
         let v = Vec3::from(v);
-        if v.is_finite() { Ok(v) } else { Err(self.err(field, "expected finite coordinates")) }
+        if v.is_finite() && v.abs().max_element() <= MAX_MAGNITUDE {
+            Ok(v)
+        } else {
+            Err(self.err(field, format!("expected finite coordinates up to ±{MAX_MAGNITUDE:e}")))
+        }
     }
 
     fn direction(&self, field: &str, v: V3) -> Result<Vec3> {
@@ -100,8 +109,8 @@ impl Ctx<'_> {
                 .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
             SpectrumDesc::Scaled(k, inner) => self.spectrum(field, inner)? * *k,
         };
-        if out.has_nan_or_inf() || out.min_value() < 0.0 {
-            return Err(self.err(field, "expected finite, non-negative values"));
+        if out.has_nan_or_inf() || out.min_value() < 0.0 || out.max_value() > MAX_MAGNITUDE {
+            return Err(self.err(field, format!("expected finite, non-negative values up to {MAX_MAGNITUDE:e}")));
         }
         Ok(out)
     }
