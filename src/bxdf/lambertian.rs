@@ -27,14 +27,22 @@ pub(super) fn pdf(wo: Vec3, wi: Vec3) -> f32 {
     if wo.z * wi.z <= 0.0 { 0.0 } else { cosine_hemisphere_pdf(wi.z.abs()) }
 }
 
-/// A cosine-weighted direction on `wo`'s side.
+/// Cosine-weighted sampling on `wo`'s side, shared by both diffuse models:
+/// `f` evaluates the model for the chosen direction.
 #[inline]
-pub(super) fn sample_wi(wo: Vec3, u: Vec2) -> Option<Vec3> {
+pub(super) fn sample_diffuse<const N: usize>(
+    wo: Vec3,
+    u: Vec2,
+    f: impl FnOnce(Vec3) -> Sampled<N>,
+) -> Option<BsdfSample<N>> {
     let mut wi = cosine_hemisphere(u);
     if wo.z < 0.0 {
         wi.z = -wi.z;
     }
-    (wi.z != 0.0 && wo.z != 0.0).then_some(wi)
+    if wi.z == 0.0 || wo.z == 0.0 {
+        return None;
+    }
+    Some(BsdfSample { wi, f: f(wi), pdf: cosine_hemisphere_pdf(wi.z.abs()), is_delta: false, eta: 1.0 })
 }
 
 impl Lambertian {
@@ -50,14 +58,7 @@ impl Lambertian {
     /// Cosine-weighted sampling.
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, u: Vec2, lambdas: &Lambdas<N>) -> Option<BsdfSample<N>> {
-        let wi = sample_wi(wo, u)?;
-        Some(BsdfSample {
-            wi,
-            f: lambdas.sample(&self.reflectance) * FRAC_1_PI,
-            pdf: cosine_hemisphere_pdf(wi.z.abs()),
-            is_delta: false,
-            eta: 1.0,
-        })
+        sample_diffuse(wo, u, |_| lambdas.sample(&self.reflectance) * FRAC_1_PI)
     }
 }
 

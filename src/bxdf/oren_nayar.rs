@@ -13,7 +13,6 @@ use std::f32::consts::FRAC_1_PI;
 
 use super::{BsdfSample, lambertian};
 use crate::color::Spectrum;
-use crate::sampling::cosine_hemisphere_pdf;
 use crate::spectral::{Lambdas, Sampled};
 
 /// Oren-Nayar reflection.
@@ -60,14 +59,7 @@ impl OrenNayar {
     /// Cosine-weighted sampling.
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, u: Vec2, lambdas: &Lambdas<N>) -> Option<BsdfSample<N>> {
-        let wi = lambertian::sample_wi(wo, u)?;
-        Some(BsdfSample {
-            wi,
-            f: self.eval(wo, wi, lambdas),
-            pdf: cosine_hemisphere_pdf(wi.z.abs()),
-            is_delta: false,
-            eta: 1.0,
-        })
+        lambertian::sample_diffuse(wo, u, |wi| self.eval(wo, wi, lambdas))
     }
 }
 
