@@ -129,7 +129,7 @@ pub struct CheckpointArgs {
     /// checkpoint is also written when the render finishes.
     #[arg(long, value_name = "PATH")]
     pub checkpoint: Option<PathBuf>,
-    /// Write a checkpoint every SECONDS (between passes).
+    /// Write a checkpoint every SECONDS (between batches of passes).
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub checkpoint_every: Option<f64>,
 }
@@ -155,7 +155,7 @@ pub struct ResumeArgs {
     /// checkpoint is also written when the render finishes.
     #[arg(long, value_name = "PATH")]
     pub checkpoint: Option<PathBuf>,
-    /// Write a checkpoint every SECONDS (between passes).
+    /// Write a checkpoint every SECONDS (between batches of passes).
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub checkpoint_every: Option<f64>,
     /// Resume even if the scene file changed since the checkpoint was written (the

@@ -214,26 +214,34 @@ impl Film {
         add_tile_to_rows(&mut self.sums, self.width, 0, tile, samples)
     }
 
-    /// Adds one pass's samples of `tiles` (row-major tiles of edge
-    /// `tile_size`, as [`tiles`] makes them; `samples[k]` belongs to
-    /// `tiles[k]`), each band of tile rows in parallel: bands own disjoint
-    /// pixel rows, and each pixel still receives exactly one sample, so the
-    /// sums are the same as adding tile by tile. Returns the invalid samples.
+    /// Adds whole passes of samples of `tiles` (row-major tiles of edge
+    /// `tile_size`, as [`tiles`] makes them): `samples` holds one buffer per
+    /// tile per pass, pass-major (`samples[p * tiles.len() + k]` belongs to
+    /// `tiles[k]` in the `p`-th pass). Each band of tile rows is added in
+    /// parallel: bands own disjoint pixel rows, and integer sums do not depend
+    /// on the order of the additions, so the sums are those of adding tile by
+    /// tile, pass by pass. The caller records the passes with `end_pass`.
+    /// Returns the invalid samples.
     pub fn add_tiles_parallel(&mut self, tiles: &[Tile], samples: &[Vec<Xyz>], tile_size: u32) -> usize {
         use rayon::prelude::*;
+        assert!(!tiles.is_empty() && samples.len() % tiles.len() == 0, "samples must hold whole passes");
         let width = self.width;
         let tiles_x = width.div_ceil(tile_size).max(1) as usize;
         let band_len = width as usize * tile_size as usize;
         self.sums
             .par_chunks_mut(band_len)
-            .zip(tiles.par_chunks(tiles_x).zip(samples.par_chunks(tiles_x)))
             .enumerate()
-            .map(|(band, (rows, (band_tiles, band_samples)))| {
+            .map(|(band, rows)| {
                 let first_row = band as u32 * tile_size;
-                band_tiles
-                    .iter()
-                    .zip(band_samples)
-                    .map(|(t, s)| add_tile_to_rows(rows, width, first_row, t, s))
+                let band_tiles = band * tiles_x..((band + 1) * tiles_x).min(tiles.len());
+                samples
+                    .chunks(tiles.len())
+                    .map(|pass| {
+                        band_tiles
+                            .clone()
+                            .map(|k| add_tile_to_rows(rows, width, first_row, &tiles[k], &pass[k]))
+                            .sum::<usize>()
+                    })
                     .sum::<usize>()
             })
             .sum()
@@ -388,6 +396,37 @@ mod tests {
     }
 
     /// f64 sums in another grouping differ; fixed-point sums do not.
+    /// Batches of passes added band by band in parallel give the sums of
+    /// adding every tile of every pass one at a time (odd sizes, partial
+    /// tiles, an invalid sample counted once).
+    #[test]
+    fn parallel_batches_equal_tile_by_tile_addition() {
+        let (w, h, size) = (37, 21, 8);
+        let ts = tiles(w, h, size);
+        let passes = 3;
+        let mut samples: Vec<Vec<Xyz>> = Vec::new();
+        for p in 0..passes {
+            for (k, t) in ts.iter().enumerate() {
+                let v: Vec<Xyz> = (0..t.len())
+                    .map(|i| {
+                        let x = (p * 1000 + k * 37 + i) as f32 * 0.013 - 3.0;
+                        Xyz::new(x, x * x, if p == 1 && k == 2 && i == 5 { f32::NAN } else { 1.0 / (1.0 + x) })
+                    })
+                    .collect();
+                samples.push(v);
+            }
+        }
+        let mut serial = Film::new(w, h);
+        let mut invalid = 0;
+        for (j, s) in samples.iter().enumerate() {
+            invalid += serial.add_tile(&ts[j % ts.len()], s);
+        }
+        let mut parallel = Film::new(w, h);
+        assert_eq!(parallel.add_tiles_parallel(&ts, &samples, size), invalid);
+        assert!(invalid >= 1);
+        assert_eq!(parallel.sums(), serial.sums());
+    }
+
     #[test]
     fn merging_halves_equals_one_accumulation() {
         let t = Tile { x0: 0, y0: 0, x1: 1, y1: 1 };

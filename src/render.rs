@@ -1,19 +1,26 @@
 //! The tile scheduler: progressive passes over the film, tiles in parallel.
 //!
-//! A pass adds one sample to every pixel (thesis §3.6). Within a pass, rayon
-//! renders the tiles in parallel; each tile's samples are computed into a
-//! buffer of its own and added to the film after the pass (each pixel gets
-//! exactly one sample per pass, so the order of tiles does not matter).
-//! Sample `k` of pixel `p` draws its random numbers from the stream
-//! `(seed, p, k)` ([`crate::sampler`]), so the image is bit-identical for any
-//! thread count or tile order, and a render of passes `a..b` is exactly the
-//! corresponding part of a longer render. No locks or atomics are touched
-//! per sample (one relaxed load of the stop flag per tile); allocation is one
-//! buffer per tile per pass. After a pass, bands of tile rows are added to the
-//! film in parallel.
+//! A pass adds one sample to every pixel (thesis §3.6). Passes are rendered
+//! in batches: a batch of `k` passes is one parallel loop over its `k × tiles`
+//! (pass, tile) tasks, pass-major, each computing one sample per pixel of its
+//! tile into a buffer of its own; after the batch, bands of tile rows add the
+//! buffers to the film in parallel. A batch holds at least
+//! [`MIN_TASKS_PER_BATCH`] tasks where the passes allow it (at most
+//! [`MAX_PASSES_PER_BATCH`] passes): a barrier per pass over only 64 tiles
+//! (a 128×128 image) left a thread idle for half a tile at the end of every
+//! pass, a few per cent of the time.
 //!
-//! A render stops early, between tiles, when its `stop` flag is set: the
-//! unfinished pass is discarded, so the film always holds whole passes.
+//! Sample `k` of pixel `p` draws its random numbers from the stream
+//! `(seed, p, k)` ([`crate::sampler`]) and the film's sums are exact integers,
+//! so the image is bit-identical for any thread count, tile order or batch
+//! size, and a render of passes `a..b` is exactly the corresponding part of
+//! a longer render. No locks or atomics are touched per sample (one relaxed
+//! load of the stop flag per task); allocation is one buffer per task.
+//!
+//! A render stops early when its `stop` flag is set: tasks not yet started
+//! are skipped, the batch's passes that finished whole (from its first one
+//! on) are kept and the rest discarded, so the film always holds whole,
+//! contiguous passes. The time budget is checked between batches.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -30,6 +37,20 @@ use crate::scene::Scene;
 
 /// Tile edge in pixels.
 pub const TILE_SIZE: u32 = 16;
+
+/// A batch of passes holds at least this many (pass, tile) tasks when the
+/// passes allow: the idle tail at a batch's end is then about half a task in
+/// this many per thread.
+pub const MIN_TASKS_PER_BATCH: usize = 256;
+
+/// The most passes in one batch: bounds the time between snapshots,
+/// checkpoints and progress reports, and what a stop can discard.
+pub const MAX_PASSES_PER_BATCH: u32 = 16;
+
+/// Passes per batch for an image of `tiles` tiles.
+pub fn passes_per_batch(tiles: usize) -> u32 {
+    (MIN_TASKS_PER_BATCH.div_ceil(tiles.max(1)) as u32).clamp(1, MAX_PASSES_PER_BATCH)
+}
 
 /// What the renderer reports after each pass.
 #[derive(Clone, Copy, Debug)]
@@ -71,7 +92,8 @@ pub struct Limits<'a> {
 }
 
 /// Renders passes `passes` (pass indices, whole samples per pixel) into
-/// `film`, calling `on_pass` on the calling thread after each completed pass.
+/// `film`, calling `on_pass` on the calling thread after each completed batch
+/// of passes.
 ///
 /// An empty film starts at `passes.start`; a film that already holds passes
 /// must end where `passes` starts (a resumed render).
@@ -105,10 +127,12 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
         }
         assert_eq!(film.pass_range().end, passes.start, "render must continue the film's passes");
         let tiles = tiles(film.width(), film.height(), TILE_SIZE);
+        let batch = passes_per_batch(tiles.len());
         let start = Instant::now();
         let mut stats = RenderStats::default();
         let planned = passes.len() as u32;
-        for pass in passes {
+        let mut next = passes.start;
+        while next < passes.end {
             if limits.stop.load(Ordering::Relaxed) {
                 stats.interrupted = true;
                 break;
@@ -117,30 +141,40 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
                 stats.out_of_time = true;
                 break;
             }
-            let results: Option<Vec<Vec<Xyz>>> = tiles
-                .par_iter()
-                .map(|tile| {
+            let k = batch.min(passes.end - next);
+            let results: Vec<Option<Vec<Xyz>>> = (0..k as usize * tiles.len())
+                .into_par_iter()
+                .map(|task| {
                     if limits.stop.load(Ordering::Relaxed) {
                         return None;
                     }
-                    Some(render_tile(scene, estimator, film.width(), tile, pass))
+                    let pass = next + (task / tiles.len()) as u32;
+                    Some(render_tile(scene, estimator, film.width(), &tiles[task % tiles.len()], pass))
                 })
                 .collect();
-            let Some(results) = results else {
+            // Keep the passes that finished whole, from the batch's first on.
+            let whole = results.chunks(tiles.len()).take_while(|p| p.iter().all(Option::is_some)).count();
+            let samples: Vec<Vec<Xyz>> = results.into_iter().take(whole * tiles.len()).flatten().collect();
+            if whole > 0 {
+                stats.invalid_samples += film.add_tiles_parallel(&tiles, &samples, TILE_SIZE) as u64;
+                for _ in 0..whole {
+                    film.end_pass();
+                }
+                stats.passes += whole as u32;
+                next += whole as u32;
+                let progress = Progress {
+                    passes_done: film.passes(),
+                    passes_planned: planned,
+                    passes_this_run: stats.passes,
+                    elapsed: start.elapsed(),
+                    samples_per_pass: film.width() as u64 * film.height() as u64,
+                };
+                on_pass(film, &progress);
+            }
+            if whole < k as usize {
                 stats.interrupted = true;
                 break;
-            };
-            stats.invalid_samples += film.add_tiles_parallel(&tiles, &results, TILE_SIZE) as u64;
-            film.end_pass();
-            stats.passes += 1;
-            let progress = Progress {
-                passes_done: film.passes(),
-                passes_planned: planned,
-                passes_this_run: stats.passes,
-                elapsed: start.elapsed(),
-                samples_per_pass: film.width() as u64 * film.height() as u64,
-            };
-            on_pass(film, &progress);
+            }
         }
         stats.elapsed = start.elapsed();
         stats

@@ -2,19 +2,21 @@
 //! PNG snapshots, checkpoints and the final outputs.
 //!
 //! Signal handlers only set flags (`signal_hook::flag::register`); all I/O
-//! happens on the main thread between passes, in the renderer's `on_pass`
-//! callback, so snapshots and checkpoints always hold whole passes:
+//! happens on the main thread between batches of passes (one pass for
+//! images of 256 tiles or more, up to 16 for small ones: [`rust_v::render`]),
+//! in the renderer's `on_pass` callback, so snapshots and checkpoints always
+//! hold whole passes:
 //! - SIGUSR1: a PNG snapshot `NAME-00128.png` (passes so far), then go on.
 //! - SIGUSR2: a checkpoint, then go on.
 //! - SIGINT, SIGTERM: set the renderer's stop flag, which its tile loop
-//!   checks, so the unfinished pass is abandoned after the tiles in flight;
+//!   checks, so unfinished passes are abandoned after the tiles in flight;
 //!   then write both and exit 0. Further SIGINTs only set the flag again:
 //!   they cannot interrupt the saving. Every file is written atomically
 //!   ([`rust_v::atomic_file`]), so even `kill -9` mid-write leaves the old
 //!   or the new file, never a torn one.
 //!
-//! Signals that arrive faster than passes complete coalesce: one snapshot
-//! or checkpoint per pass at most.
+//! Signals that arrive faster than batches complete coalesce: one snapshot
+//! or checkpoint per batch at most.
 
 use std::path::PathBuf;
 use std::sync::Arc;
