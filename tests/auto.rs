@@ -45,8 +45,9 @@ fn auto_matches_spectral_hero_with_dispersion() {
 }
 
 /// The invisible glass sphere (dispersive N-BK7 in a uniform enclosure) is
-/// invisible to `auto` too: the collapse to a hero packet keeps every bin's
-/// weight (36/C) so the image mean is the enclosure's radiance.
+/// invisible to `auto` too: the reflect-or-collapse choice and the
+/// importance-drawn bins keep every bin's expected weight, so the image mean
+/// is the enclosure's radiance.
 #[test]
 fn auto_sees_through_the_glass_sphere() {
     let scene = r#"(

@@ -17,17 +17,68 @@
 use glam::Vec3;
 
 use super::{BsdfSample, Ior, fresnel_dielectric, refract};
-use crate::spectral::Sampled;
+use crate::color::{N_BINS, bin_lambda_nm};
+use crate::spectral::{Lambdas, Sampled};
 
 /// A smooth dielectric; the outside (the side the normal points to) is the
 /// scene's medium, of index 1 (vacuum; see the crate docs).
 #[derive(Clone, Debug)]
 pub struct Dielectric {
     /// Index of refraction of the inside.
-    pub ior: Ior,
+    ior: Ior,
+    /// The index at each bin's wavelength (the Sellmeier equation costs
+    /// three f64 divisions and a square root per wavelength).
+    bin_ior: [f32; N_BINS],
 }
 
 impl Dielectric {
+    /// A dielectric of index `ior` inside.
+    pub fn new(ior: Ior) -> Self {
+        let bin_ior = std::array::from_fn(|b| ior.at(bin_lambda_nm(b)));
+        Dielectric { ior, bin_ior }
+    }
+
+    /// The index of refraction of the inside.
+    #[inline]
+    pub fn ior(&self) -> &Ior {
+        &self.ior
+    }
+
+    /// The index at wavelength `lambda_nm`, from the table at bin wavelengths.
+    #[inline]
+    pub fn eta(&self, lambda_nm: f32) -> f32 {
+        let pos = (lambda_nm - crate::color::LAMBDA_MIN_NM) / crate::color::LAMBDA_STEP_NM;
+        if pos >= 0.0 && pos.fract() == 0.0 && (pos as usize) < N_BINS {
+            self.bin_ior[pos as usize]
+        } else {
+            self.ior.at(lambda_nm)
+        }
+    }
+
+    /// The Fresnel reflectance at each of the packet's wavelengths, for a
+    /// direction `wo` (local frame) outside or inside.
+    #[inline]
+    pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
+        Sampled(std::array::from_fn(|i| fresnel_dielectric(wo.z, self.eta(lambdas.lambda_nm(i)))))
+    }
+
+    /// The refraction alone for index `eta`, as a sample of probability 1
+    /// whose weight `f |cos θ| / pdf` is the radiance scaling `1 / η²`: the
+    /// integrator has already chosen refraction and weighted it by `T`.
+    /// `None` on total internal reflection or a grazing direction.
+    #[inline]
+    pub fn sample_refraction<const N: usize>(&self, wo: Vec3, eta: f32) -> Option<BsdfSample<N>> {
+        if wo.z.abs() < f32::MIN_POSITIVE {
+            return None;
+        }
+        let (wi, etap) = refract(wo, Vec3::Z, eta)?;
+        if wi.z.abs() < f32::MIN_POSITIVE {
+            return None;
+        }
+        let f = 1.0 / (wi.z.abs() * etap * etap);
+        Some(BsdfSample { wi, f: Sampled::splat(f), pdf: 1.0, is_delta: true, eta: etap })
+    }
+
     /// Samples reflection or refraction for index `eta` (inside / outside).
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, uc: f32, eta: f32) -> Option<BsdfSample<N>> {
@@ -62,7 +113,7 @@ mod tests {
     /// both sides, for normal and total internal reflection.
     #[test]
     fn reflection_plus_transmission_is_one() {
-        let d = Dielectric { ior: Ior::Constant(1.5) };
+        let d = Dielectric::new(Ior::Constant(1.5));
         for cos in [1.0f32, 0.7, 0.3, 0.05, -0.05, -0.5, -0.9, -1.0] {
             let sin = (1.0 - cos * cos).sqrt();
             let wo = Vec3::new(sin, 0.0, cos);
@@ -87,7 +138,7 @@ mod tests {
     #[test]
     fn snell_per_wavelength() {
         let ior = crate::bxdf::named_glass("N-BK7").unwrap();
-        let d = Dielectric { ior: ior.clone() };
+        let d = Dielectric::new(ior.clone());
         let theta = 50f32.to_radians();
         let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
         let mut last_sin_t = 0.0;
@@ -99,5 +150,36 @@ mod tests {
             assert!(sin_t > last_sin_t, "longer wavelengths bend less");
             last_sin_t = sin_t;
         }
+    }
+
+    /// The per-bin index table equals the formula at every bin's wavelength,
+    /// and other wavelengths use the formula; the forced refraction is the
+    /// sampled one with weight 1/η² (its branch probability taken out), and
+    /// the per-wavelength reflectance is the Fresnel term at each index.
+    #[test]
+    fn bin_table_forced_refraction_and_reflectance_agree_with_the_formulas() {
+        let ior = crate::bxdf::named_glass("N-SF11").unwrap();
+        let d = Dielectric::new(ior.clone());
+        for b in 0..N_BINS {
+            assert_eq!(d.eta(bin_lambda_nm(b)), ior.at(bin_lambda_nm(b)));
+        }
+        assert_eq!(d.eta(589.3), ior.at(589.3));
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let lambdas =
+            Lambdas::<4> { pos: [0.0, 9.0, 18.0, 27.0], weight: 9.0, readout: crate::spectral::Readout::Spectral };
+        let fr = d.reflectance(wo, &lambdas);
+        for i in 0..4 {
+            let eta = d.eta(lambdas.lambda_nm(i));
+            assert_eq!(fr[i], fresnel_dielectric(0.8, eta));
+            let forced: BsdfSample<1> = d.sample_refraction(wo, eta).unwrap();
+            let sampled: BsdfSample<1> = d.sample(wo, 0.999_999, eta).unwrap();
+            assert!((forced.wi - sampled.wi).length() < 1e-6 && forced.eta == sampled.eta);
+            let w = forced.f[0] * forced.wi.z.abs() / forced.pdf;
+            assert!((w * forced.eta * forced.eta - 1.0).abs() < 1e-5);
+        }
+        assert!(fr[0] > fr[3], "violet reflects more than red in dense flint");
+        // Total internal reflection: no refraction to force.
+        let inside = Vec3::new(0.9, 0.0, -(1.0f32 - 0.81).sqrt());
+        assert!(d.sample_refraction::<1>(inside, 1.8).is_none());
     }
 }

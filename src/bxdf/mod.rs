@@ -100,7 +100,7 @@ impl Bxdf {
             Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
-            Bxdf::Dielectric(m) => m.sample(wo, uc, m.ior.at(lambda_nm)),
+            Bxdf::Dielectric(m) => m.sample(wo, uc, m.eta(lambda_nm)),
         }
     }
 
@@ -123,7 +123,7 @@ impl Bxdf {
     #[inline]
     pub fn is_dispersive(&self) -> bool {
         match self {
-            Bxdf::Dielectric(d) => d.ior.is_dispersive(),
+            Bxdf::Dielectric(d) => d.ior().is_dispersive(),
             _ => false,
         }
     }

@@ -265,8 +265,8 @@ fn all_models() -> Vec<(&'static str, Bxdf)> {
         ("Oren-Nayar σ=60", Bxdf::OrenNayar(OrenNayar::new(rho, 60.0))),
         ("Oren-Nayar σ=90", Bxdf::OrenNayar(OrenNayar::new(rho, 90.0))),
         ("Mirror", Bxdf::Mirror(Mirror { reflectance: rho })),
-        ("Dielectric 1.5", Bxdf::Dielectric(Dielectric { ior: Ior::Constant(1.5) })),
-        ("Dielectric N-SF11", Bxdf::Dielectric(Dielectric { ior: named_glass("N-SF11").unwrap() })),
+        ("Dielectric 1.5", Bxdf::Dielectric(Dielectric::new(Ior::Constant(1.5)))),
+        ("Dielectric N-SF11", Bxdf::Dielectric(Dielectric::new(named_glass("N-SF11").unwrap()))),
     ]
 }
 
@@ -350,10 +350,10 @@ fn every_model_conserves_energy_at_all_angles_and_wavelengths() {
 fn dielectric_r_plus_t_is_one_for_every_glass_wavelength_and_angle() {
     let l = Lambdas::<1> { pos: [0.0], weight: 36.0, readout: crate::spectral::Readout::Spectral };
     for (glass, _, _) in NAMED_GLASSES {
-        let d = Dielectric { ior: named_glass(glass).unwrap() };
+        let d = Dielectric::new(named_glass(glass).unwrap());
         for bin in 0..N_BINS {
             let lambda = crate::color::bin_lambda_nm(bin);
-            let eta = d.ior.at(lambda);
+            let eta = d.ior().at(lambda);
             let mut cos = 1.0f32;
             while cos > 1e-7 {
                 for side in [1.0f32, -1.0] {

@@ -7,7 +7,7 @@
 //! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
 //! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
 //! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface; or `--wavelengths rgb` |
-//! | `auto` (default) | as `path` | the full spectrum until the first dispersive surface, where the path collapses to a hero packet of `C` bins (weight 36/C) that splits as in `spectral`: no wavelength noise where nothing disperses |
+//! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
 //! ([`crate::spectral`]), and picked once per render ([`Estimator`]) so the
@@ -131,7 +131,7 @@ pub fn describe(scene: &Scene) -> String {
     let dispersive = scene.has_dispersion();
     match s.integrator {
         IntegratorKind::Auto if dispersive => format!(
-            "auto: dispersive material present: full-spectrum path tracing, collapsing to hero packets of {} wavelengths at a path's first dispersive surface",
+            "auto: dispersive material present: full-spectrum path tracing; a path that refracts at dispersive glass continues as {} single wavelengths drawn by throughput and visual importance",
             s.packet_size
         ),
         IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),

@@ -2,26 +2,33 @@
 //! (power heuristic), Russian roulette, and wavelength packets that split at
 //! dispersive surfaces (thesis §2.4.1-2.4.2, pbrt-v4 §13.4).
 //!
-//! One walk serves the `path` and `spectral` integrators:
+//! One walk serves the `path`, `spectral` and `auto` integrators:
 //! 1. intersect; at an emitter add `β · L_e`, MIS-weighted against light
 //!    sampling unless the previous bounce was delta (or this is the camera ray);
 //! 2. stop after `max_bounces` scattering events;
 //! 3. at a dispersive surface, when dispersion is on and the packet has more
 //!    than one wavelength, continue as `N` single-wavelength walks from this
 //!    very hit (each keeps its own throughput, weight and sampler stream
-//!    position; their colours add);
+//!    position; their colours add). The full spectrum (`auto`) first chooses
+//!    between reflection, which is the same direction for every wavelength
+//!    and keeps the full spectrum, and refraction, which collapses the path
+//!    to `C` bins drawn in proportion to throughput × visual importance
+//!    (`PathTracer::collapse`);
 //! 4. at a non-delta surface add direct light (one light sample, MIS);
 //! 5. sample the BSDF for the next direction and update `β ← β f |cos| / pdf`;
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
+use crate::bxdf::{BsdfSample, Bxdf, Dielectric};
 use crate::color::N_BINS;
 use crate::color::Xyz;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
-use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM, Readout, Sampled, hero_bin};
+use crate::spectral::{
+    BinDistribution, Lambdas, REFERENCE_LAMBDA_NM, Readout, Sampled, bin_importance, for_each_rotated,
+};
 
 use super::{Shading, sample_direct};
 
@@ -72,7 +79,7 @@ impl PathTracer {
             bounces: 0,
             prev: Prev { p: ray.origin, pdf_bsdf: 0.0, delta: true },
         };
-        self.walk(scene, ray, si, walk, lambdas, sampler, true)
+        self.walk(scene, ray, si, walk, lambdas, sampler, Start::Camera)
     }
 
     /// Continues a path that arrived along `ray` at `si`.
@@ -85,10 +92,11 @@ impl PathTracer {
         mut w: Walk<N>,
         lambdas: &Lambdas<N>,
         sampler: &mut Sampler,
-        mut add_emission: bool,
+        mut start: Start,
     ) -> Xyz {
         let mut l = Sampled::<N>::splat(0.0);
         let mut split = Xyz::default();
+        let mut add_emission = start == Start::Camera;
         loop {
             let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
@@ -115,32 +123,25 @@ impl PathTracer {
             if bxdf.is_black() {
                 break;
             }
-            // 3. A dispersive surface splits the packet into single wavelengths;
-            //    the full spectrum first collapses to a hero packet (`auto`).
+            let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
+            // 3. A dispersive surface splits the packet into single wavelengths.
+            let mut reflect = None;
             if N > 1 && self.disperse && bxdf.is_dispersive() {
                 if N == N_BINS && lambdas.readout == Readout::Spectral {
-                    // Each bin joins the packet with probability C/36: weight 36/C.
-                    let c = self.collapse_to as usize;
-                    let hero = ((sampler.next_1d() * N_BINS as f32) as usize).min(N_BINS - 1);
-                    for k in 0..c {
-                        let bin = hero_bin(hero, k, c);
-                        let one = Walk { beta: Sampled([w.beta[bin]]), ..copy_walk(&w) };
-                        let l1 = Lambdas {
-                            pos: [bin as f32],
-                            weight: lambdas.weight * N_BINS as f32 / c as f32,
-                            readout: Readout::Spectral,
-                        };
-                        split = split + self.walk::<1>(scene, ray, si, one, &l1, sampler, false);
+                    // `auto`: reflection keeps the full spectrum, refraction collapses.
+                    let Bxdf::Dielectric(glass) = bxdf else { unreachable!("only dielectrics disperse") };
+                    match self.collapse(scene, ray, si, &sh, glass, &w, lambdas, sampler, &mut split) {
+                        Some(fr) => reflect = Some(fr),
+                        None => break,
                     }
                 } else {
                     for i in 0..N {
                         let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
-                        split = split + self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, false);
+                        split = split + self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
                     }
+                    break;
                 }
-                break;
             }
-            let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             // 4. Direct light.
             if !bxdf.is_delta() {
                 l += w.beta * sample_direct(scene, bxdf, &sh, lambdas, sampler, true);
@@ -149,7 +150,14 @@ impl PathTracer {
             let u = sampler.next_2d();
             let uc = sampler.next_1d();
             let lambda_nm = if N == 1 && self.disperse { lambdas.lambda_nm(0) } else { REFERENCE_LAMBDA_NM };
-            let Some(bs) = bxdf.sample(sh.wo, u, uc, lambdas, lambda_nm) else {
+            let sample = match (reflect.take(), std::mem::replace(&mut start, Start::Camera), bxdf) {
+                (Some(weight), ..) => Some(mirror(sh.wo, weight)),
+                (None, Start::SplitRefraction, Bxdf::Dielectric(glass)) => {
+                    glass.sample_refraction(sh.wo, glass.eta(lambda_nm))
+                }
+                _ => bxdf.sample(sh.wo, u, uc, lambdas, lambda_nm),
+            };
+            let Some(bs) = sample else {
                 break;
             };
             let wi = sh.frame.to_world(bs.wi);
@@ -179,6 +187,78 @@ impl PathTracer {
         }
         lambdas.to_xyz(&l) + split
     }
+}
+
+impl PathTracer {
+    /// `auto` at a dispersive dielectric, with the full spectrum. Reflection
+    /// sends every wavelength the same way, so it is chosen first, with
+    /// probability `P_r` = the reflectance averaged with weights
+    /// throughput × visual importance, and the path goes on full-spectrum
+    /// with per-bin weight `F(λ) / P_r` (returned, as the value of the mirror
+    /// lobe). Otherwise the throughput becomes `β(λ) (1 − F(λ)) / (1 − P_r)`
+    /// and the path collapses: `C` bins drawn in proportion to that throughput
+    /// times [`bin_importance`], each weighted `1 / (C · p(bin))`, each
+    /// refracting at its own index as a single-wavelength walk whose colour is
+    /// added to `split`. Returns `None` after a collapse (or a dead path).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn collapse<const N: usize>(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        si: SurfaceHit,
+        sh: &Shading,
+        glass: &Dielectric,
+        w: &Walk<N>,
+        lambdas: &Lambdas<N>,
+        sampler: &mut Sampler,
+        split: &mut Xyz,
+    ) -> Option<Sampled<N>> {
+        let importance = bin_importance();
+        let fr = glass.reflectance(sh.wo, lambdas);
+        let (mut total, mut reflected) = (0.0f32, 0.0f32);
+        for i in 0..N {
+            let v = w.beta[i] * importance[i];
+            total += v;
+            reflected += v * fr[i];
+        }
+        if !(total > 0.0) {
+            return None;
+        }
+        let p_reflect = (reflected / total).clamp(0.0, 1.0);
+        if sampler.next_1d() < p_reflect {
+            return Some(fr / p_reflect);
+        }
+        let p_refract = 1.0 - p_reflect;
+        let beta: Sampled<N> = Sampled(std::array::from_fn(|i| w.beta[i] * (1.0 - fr[i]) / p_refract));
+        let dist = BinDistribution::new(|b| beta[b] * importance[b])?;
+        let u = sampler.next_1d();
+        for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
+            let one = Walk { beta: Sampled([beta[bin]]), ..copy_walk(w) };
+            let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
+            *split = *split + self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
+        });
+        None
+    }
+}
+
+/// How a walk starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Start {
+    /// From the camera: emission seen directly counts.
+    Camera,
+    /// A single wavelength split off at this very hit (emission already counted).
+    Split,
+    /// As `Split`, and refraction was already chosen (and weighted) at this hit.
+    SplitRefraction,
+}
+
+/// The mirror direction of `wo` (local frame) as a delta sample of probability
+/// 1 whose weight `f |cos θ| / pdf` is `weight`.
+#[inline]
+fn mirror<const N: usize>(wo: glam::Vec3, weight: Sampled<N>) -> BsdfSample<N> {
+    let wi = glam::Vec3::new(-wo.x, -wo.y, wo.z);
+    BsdfSample { wi, f: weight / wi.z.abs().max(f32::MIN_POSITIVE), pdf: 1.0, is_delta: true, eta: 1.0 }
 }
 
 /// The packet-independent part of a walk's state, for a split.

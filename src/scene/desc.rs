@@ -93,7 +93,7 @@ pub struct RenderDesc {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum IntegratorKind {
-    /// The default: full spectrum until a path meets a dispersive surface, then hero packets that split.
+    /// The default: full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
     Auto,
     /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
     Path,

@@ -162,7 +162,7 @@ impl Ctx<'_> {
                 Bxdf::Mirror(Mirror { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
             }
             MaterialDesc::Dielectric { ior } => {
-                Bxdf::Dielectric(Dielectric { ior: self.ior(&format!("{field}.ior"), ior)? })
+                Bxdf::Dielectric(Dielectric::new(self.ior(&format!("{field}.ior"), ior)?))
             }
             MaterialDesc::Black => Bxdf::Black,
         })
