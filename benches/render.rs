@@ -1,7 +1,13 @@
 //! Render throughput: samples per second on the committed scenes at 128x128,
-//! on 1 and 2 threads (median of 3 runs each), and the scaling ratio, for
-//! the full-spectrum integrators (`path`, `auto` collapsing to 4 or 8) and
-//! hero packets of 4 and 8 wavelengths.
+//! on 1 and 2 threads, and the scaling ratio, for the full-spectrum
+//! integrators (`path`, `auto` collapsing to 4 or 8) and hero packets of 4
+//! and 8 wavelengths.
+//!
+//! Each method runs 5 rounds of one 1-thread and one 2-thread render of 32
+//! passes, alternating, so that both see the same machine load; the table
+//! gives the median rate of each and the median of the 5 per-round ratios
+//! (on a shared machine a ratio of medians taken minutes apart mixes in
+//! the load's drift).
 //!
 //! `cargo bench --bench render [-- SCENE...]`
 
@@ -56,38 +62,23 @@ fn main() {
                     break;
                 }
             };
-            let passes = 16;
-            let mut rates = Vec::new();
-            for threads in [1, 2] {
-                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("thread pool");
-                let runs: Vec<f64> = (0..3)
-                    .map(|_| {
-                        let mut film = Film::new(128, 128);
-                        let stop = AtomicBool::new(false);
-                        let t = Instant::now();
-                        pool.install(|| {
-                            render(
-                                &scene,
-                                &mut film,
-                                0..passes,
-                                Limits { stop: &stop, time_budget: None },
-                                &mut |_, _| {},
-                            )
-                        });
-                        (passes as f64 * 128.0 * 128.0) / t.elapsed().as_secs_f64() / 1e6
-                    })
-                    .collect();
-                rates.push(median(runs));
-            }
-            println!(
-                "{:<28} {:>10} {:>8} {:>14.3} {:>14.3} {:>8.2}",
-                scene_path,
-                name,
-                passes,
-                rates[0],
-                rates[1],
-                rates[1] / rates[0]
-            );
+            let passes = 32;
+            let pools: Vec<rayon::ThreadPool> =
+                [1, 2].map(|t| rayon::ThreadPoolBuilder::new().num_threads(t).build().expect("thread pool")).into();
+            let rate = |pool: &rayon::ThreadPool| {
+                let mut film = Film::new(128, 128);
+                let stop = AtomicBool::new(false);
+                let t = Instant::now();
+                pool.install(|| {
+                    render(&scene, &mut film, 0..passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {})
+                });
+                (passes as f64 * 128.0 * 128.0) / t.elapsed().as_secs_f64() / 1e6
+            };
+            let rounds: Vec<(f64, f64)> = (0..5).map(|_| (rate(&pools[0]), rate(&pools[1]))).collect();
+            let one = median(rounds.iter().map(|r| r.0).collect());
+            let two = median(rounds.iter().map(|r| r.1).collect());
+            let ratio = median(rounds.iter().map(|r| r.1 / r.0).collect());
+            println!("{:<28} {:>10} {:>8} {:>14.3} {:>14.3} {:>8.2}", scene_path, name, passes, one, two, ratio);
         }
     }
 }

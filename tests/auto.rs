@@ -84,3 +84,34 @@ fn auto_one_spp_is_as_bright_as_converged() {
     let tol = 5.0 * (se * se + want_se * want_se).sqrt();
     assert!((mean - want).abs() < tol, "1-spp mean Y {mean:.5} vs converged {want:.5} (tol {tol:.5})");
 }
+
+/// Inside glass (the camera in a dense flint sphere, looking out at a
+/// coloured enclosure and a coloured wall, through total internal reflection
+/// near the rim) `auto` takes the branch that weighs every bin's reflectance
+/// before choosing reflection or refraction. It must estimate the same image
+/// as hero packets, which never take that branch: block means within 6
+/// standard errors from 8 seeds each (see `spectral::assert_same_image`).
+#[test]
+fn auto_matches_hero_from_inside_glass() {
+    let scene = r#"(
+        camera: (eye: (0.3, 0.2, 1.2), look_at: (0, 0, -3), fov_deg: 100),
+        render: (max_bounces: 24),
+        materials: {
+            "flint": Dielectric(ior: Named("N-SF11")),
+            "wall": Lambertian(reflectance: ColorChecker("cyan")),
+        },
+        objects: [
+            (shape: Sphere(center: (0, 0, 0), radius: 1.6), material: "flint"),
+            (shape: Sphere(center: (0, 0, -2.5), radius: 0.6), material: "wall"),
+            (shape: Sphere(center: (0, 0, 0), radius: 10), emission: Blackbody(3000), two_sided: true),
+        ],
+    )"#;
+    let auto = crate::spectral::block_stats(scene, |s| with(IntegratorKind::Auto, 16, 500 + s), 8, 4);
+    let hero = crate::spectral::block_stats(
+        scene,
+        |s| RenderDesc { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 16, 600 + s) },
+        8,
+        4,
+    );
+    crate::spectral::assert_same_image(&auto, &hero, "auto vs hero inside glass");
+}

@@ -18,7 +18,7 @@ use glam::Vec3;
 
 use super::{BsdfSample, Ior, fresnel_dielectric, refract};
 use crate::color::{N_BINS, bin_lambda_nm};
-use crate::spectral::{Lambdas, Sampled};
+use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM, Sampled};
 
 /// A smooth dielectric; the outside (the side the normal points to) is the
 /// scene's medium, of index 1 (vacuum; see the crate docs).
@@ -29,19 +29,28 @@ pub struct Dielectric {
     /// The index at each bin's wavelength (the Sellmeier equation costs
     /// three f64 divisions and a square root per wavelength).
     bin_ior: [f32; N_BINS],
+    /// The index at the reference wavelength, 589.3 nm.
+    reference_ior: f32,
 }
 
 impl Dielectric {
     /// A dielectric of index `ior` inside.
     pub fn new(ior: Ior) -> Self {
         let bin_ior = std::array::from_fn(|b| ior.at(bin_lambda_nm(b)));
-        Dielectric { ior, bin_ior }
+        let reference_ior = ior.at(REFERENCE_LAMBDA_NM);
+        Dielectric { ior, bin_ior, reference_ior }
     }
 
     /// The index of refraction of the inside.
     #[inline]
     pub fn ior(&self) -> &Ior {
         &self.ior
+    }
+
+    /// The index at the reference wavelength, 589.3 nm (the sodium D line).
+    #[inline]
+    pub fn reference_eta(&self) -> f32 {
+        self.reference_ior
     }
 
     /// The index at wavelength `lambda_nm`, from the table at bin wavelengths.
@@ -164,6 +173,7 @@ mod tests {
             assert_eq!(d.eta(bin_lambda_nm(b)), ior.at(bin_lambda_nm(b)));
         }
         assert_eq!(d.eta(589.3), ior.at(589.3));
+        assert_eq!(d.reference_eta(), ior.at(589.3));
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let lambdas =
             Lambdas::<4> { pos: [0.0, 9.0, 18.0, 27.0], weight: 9.0, readout: crate::spectral::Readout::Spectral };

@@ -19,7 +19,7 @@
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
-use crate::bxdf::{BsdfSample, Bxdf, Dielectric};
+use crate::bxdf::{BsdfSample, Bxdf, Dielectric, fresnel_dielectric};
 use crate::color::N_BINS;
 use crate::color::Xyz;
 use crate::geometry::Ray;
@@ -191,15 +191,23 @@ impl PathTracer {
 
 impl PathTracer {
     /// `auto` at a dispersive dielectric, with the full spectrum. Reflection
-    /// sends every wavelength the same way, so it is chosen first, with
-    /// probability `P_r` = the reflectance averaged with weights
-    /// throughput × visual importance, and the path goes on full-spectrum
-    /// with per-bin weight `F(λ) / P_r` (returned, as the value of the mirror
-    /// lobe). Otherwise the throughput becomes `β(λ) (1 − F(λ)) / (1 − P_r)`
-    /// and the path collapses: `C` bins drawn in proportion to that throughput
-    /// times [`bin_importance`], each weighted `1 / (C · p(bin))`, each
-    /// refracting at its own index as a single-wavelength walk whose colour is
-    /// added to `split`. Returns `None` after a collapse (or a dead path).
+    /// sends every wavelength the same way, so it is chosen first, with a
+    /// probability `P_r`, and the path goes on full-spectrum with per-bin
+    /// weight `F(λ) / P_r` (returned, as the value of the mirror lobe).
+    /// Otherwise the path collapses: `C` bins drawn in proportion to
+    /// throughput × [`bin_importance`], each weighted `1 / (C · p(bin))`,
+    /// each refracting at its own index as a single-wavelength walk of
+    /// throughput `β(λ) (1 − F(λ)) / (1 − P_r)` whose colour is added to
+    /// `split`. Returns `None` after a collapse (or a dead path).
+    ///
+    /// Any `P_r` that is below 1 wherever some wavelength is transmitted keeps
+    /// this unbiased. Arriving from outside (always, unless the camera or an
+    /// emitter sits inside glass) nothing is totally reflected, so `P_r` is
+    /// the reflectance at 589.3 nm and only the drawn bins' reflectances are
+    /// computed: evaluating all 36 at every glass hit cost 10% of the
+    /// instructions of a prism render. From inside, `P_r` is the reflectance
+    /// averaged over the bins with weights throughput × importance, which is
+    /// 1 only when every bin is totally reflected.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn collapse<const N: usize>(
@@ -215,26 +223,35 @@ impl PathTracer {
         split: &mut Xyz,
     ) -> Option<Sampled<N>> {
         let importance = bin_importance();
-        let fr = glass.reflectance(sh.wo, lambdas);
-        let (mut total, mut reflected) = (0.0f32, 0.0f32);
-        for i in 0..N {
-            let v = w.beta[i] * importance[i];
-            total += v;
-            reflected += v * fr[i];
-        }
-        if !(total > 0.0) {
-            return None;
-        }
-        let p_reflect = (reflected / total).clamp(0.0, 1.0);
+        let cos = sh.wo.z;
+        let (p_reflect, all_fr) = if cos > 0.0 {
+            (fresnel_dielectric(cos, glass.reference_eta()), None)
+        } else {
+            let fr = glass.reflectance(sh.wo, lambdas);
+            let (mut total, mut reflected) = (0.0f32, 0.0f32);
+            for i in 0..N {
+                let v = w.beta[i] * importance[i];
+                total += v;
+                reflected += v * fr[i];
+            }
+            if !(total > 0.0) {
+                return None;
+            }
+            ((reflected / total).clamp(0.0, 1.0), Some(fr))
+        };
         if sampler.next_1d() < p_reflect {
+            let fr = all_fr.unwrap_or_else(|| glass.reflectance(sh.wo, lambdas));
             return Some(fr / p_reflect);
         }
         let p_refract = 1.0 - p_reflect;
-        let beta: Sampled<N> = Sampled(std::array::from_fn(|i| w.beta[i] * (1.0 - fr[i]) / p_refract));
-        let dist = BinDistribution::new(|b| beta[b] * importance[b])?;
+        let dist = BinDistribution::new(|b| w.beta[b] * importance[b])?;
         let u = sampler.next_1d();
         for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
-            let one = Walk { beta: Sampled([beta[bin]]), ..copy_walk(w) };
+            let fr = match all_fr {
+                Some(fr) => fr[bin],
+                None => fresnel_dielectric(cos, glass.eta(lambdas.lambda_nm(bin))),
+            };
+            let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
             *split = *split + self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
         });
