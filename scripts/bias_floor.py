@@ -5,14 +5,14 @@
 
 An unbiased method's error against a reference falls as MSE(n) = a / n + c,
 where `c` is the reference's own noise, the same for every method; a biased
-method's levels off at c + B, B being its squared bias. The script fits the
-unbiased methods (all but --against, default `path`) together, one `a` each
-and a shared `c`, then the --against method alone with its own `a` and
-floor c + B (least squares, weights 1 / MSE², medians over seeds,
-checkpoints from --min-spp on), and prints each `a`, the floors and the
-seconds per spp. B is the difference of two fitted floors, each a small part
-of the error at the last checkpoint: treat it as an estimate to within a
-factor of about two, and measure a high-spp render where it matters.
+method's levels off at c + B, B being its squared bias. The script fits
+each method alone, MSE = a / spp + floor (least squares, weights 1 / MSE²,
+medians over seeds, checkpoints from --min-spp on), and prints `a`, the
+floor and the seconds per spp; the squared bias of the --against method
+(default `path`) is B = floor(against) - floor(auto). B is the difference of
+two fitted floors, each a small part of the error at the last checkpoint:
+treat it as an estimate to within a factor of about two, and measure it with
+a high-spp study where it matters (identical methods give B = 0 exactly).
 
 Error against time: a method reaching the reference's floor plus `e` takes
 t(e) = (a / e) * (seconds per spp). For `auto` against the biased method,
@@ -47,7 +47,8 @@ def solve(m, v):
 
 def fit(series):
     """Weighted least squares of m = a_j / n + c over series j of (n, m) points,
-    one a_j per series and one shared c: returns ([a_j], c)."""
+    one a_j per series and one shared c: returns ([a_j], c). (Called with one
+    series per method.)"""
     k = len(series)
     ata = [[0.0] * (k + 1) for _ in range(k + 1)]
     atb = [0.0] * (k + 1)
@@ -92,14 +93,11 @@ def main():
             pts[m] = [(float(r["spp"]), float(r[metric + "_median"])) for r in rs if float(r["spp"]) >= min_spp]
             last = max(rs, key=lambda r: float(r["spp"]))
             sps[m] = float(last["seconds_median"]) / float(last["spp"])
-        unbiased = [m for m in rows if m != against and len(pts[m]) >= 2]
-        if not unbiased:
-            continue
-        a_list, c = fit([pts[m] for m in unbiased])
-        res = {m: (a, c) for m, a in zip(unbiased, a_list)}
-        if against in rows and len(pts[against]) >= 3:
-            (ap,), cp = fit([pts[against]])
-            res[against] = (max(ap, 0.0), cp)
+        res = {}
+        for m in rows:
+            if len(pts[m]) >= 3:
+                (a,), floor = fit([pts[m]])
+                res[m] = (max(a, 0.0), floor)
         for m, (a, floor) in res.items():
             print(f"| {m} | {a:.4g} | {floor:.4g} | {sps[m]:.4g} | {a * sps[m]:.4g} |")
         if "auto" in res and against in res:
@@ -108,7 +106,9 @@ def main():
             bias = cp - ca
             big_a, big_p = aa * sa, ap * sp
             print(f"\n{against}: squared bias B = {bias:.4g}")
-            if bias <= 0:
+            if big_p == 0:
+                print(f"{against} does not converge (a = 0): auto is faster below {bias:.4g}")
+            elif bias <= 0:
                 print(f"no measurable bias: `auto` is never faster than {against} by this fit")
             elif big_a <= big_p:
                 print(f"auto is faster than {against} at every target")

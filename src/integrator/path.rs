@@ -202,12 +202,14 @@ impl PathTracer {
     ///
     /// Any `P_r` that is below 1 wherever some wavelength is transmitted keeps
     /// this unbiased. Arriving from outside (always, unless the camera or an
-    /// emitter sits inside glass) nothing is totally reflected, so `P_r` is
-    /// the reflectance at 589.3 nm and only the drawn bins' reflectances are
-    /// computed: evaluating all 36 at every glass hit cost 10% of the
-    /// instructions of a prism render. From inside, `P_r` is the reflectance
-    /// averaged over the bins with weights throughput × importance, which is
-    /// 1 only when every bin is totally reflected.
+    /// emitter sits inside glass) into glass whose index at 589.3 nm is at
+    /// least 1, that wavelength is never totally reflected, so `P_r` is its
+    /// reflectance and only the drawn bins' reflectances are computed
+    /// (evaluating all 36 at every glass hit cost 10% of the instructions of
+    /// a prism render); a bin that is totally reflected gets throughput 0.
+    /// Otherwise `P_r` is the reflectance averaged over the bins with weights
+    /// throughput × importance, which is 1 only when every bin is totally
+    /// reflected.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn collapse<const N: usize>(
@@ -224,7 +226,7 @@ impl PathTracer {
     ) -> Option<Sampled<N>> {
         let importance = bin_importance();
         let cos = sh.wo.z;
-        let (p_reflect, all_fr) = if cos > 0.0 {
+        let (p_reflect, all_fr) = if cos > 0.0 && glass.reference_eta() >= 1.0 {
             (fresnel_dielectric(cos, glass.reference_eta()), None)
         } else {
             let fr = glass.reflectance(sh.wo, lambdas);
