@@ -395,7 +395,6 @@ mod tests {
         assert_eq!(f.add_tile(&t, &[Xyz::new(1e30, 0.0, 0.0)]), 1);
     }
 
-    /// f64 sums in another grouping differ; fixed-point sums do not.
     /// Batches of passes added band by band in parallel give the sums of
     /// adding every tile of every pass one at a time (odd sizes, partial
     /// tiles, an invalid sample counted once).
@@ -427,6 +426,7 @@ mod tests {
         assert_eq!(parallel.sums(), serial.sums());
     }
 
+    /// f64 sums in another grouping differ; fixed-point sums do not.
     #[test]
     fn merging_halves_equals_one_accumulation() {
         let t = Tile { x0: 0, y0: 0, x1: 1, y1: 1 };

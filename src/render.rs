@@ -153,10 +153,17 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
                 })
                 .collect();
             // Keep the passes that finished whole, from the batch's first on.
-            let whole = results.chunks(tiles.len()).take_while(|p| p.iter().all(Option::is_some)).count();
+            // (An empty film has no tiles: its passes are trivially whole.)
+            let whole = if tiles.is_empty() {
+                k as usize
+            } else {
+                results.chunks(tiles.len()).take_while(|p| p.iter().all(Option::is_some)).count()
+            };
             let samples: Vec<Vec<Xyz>> = results.into_iter().take(whole * tiles.len()).flatten().collect();
             if whole > 0 {
-                stats.invalid_samples += film.add_tiles_parallel(&tiles, &samples, TILE_SIZE) as u64;
+                if !tiles.is_empty() {
+                    stats.invalid_samples += film.add_tiles_parallel(&tiles, &samples, TILE_SIZE) as u64;
+                }
                 for _ in 0..whole {
                     film.end_pass();
                 }

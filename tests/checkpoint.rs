@@ -90,6 +90,16 @@ fn a_stop_mid_batch_keeps_whole_passes_only() {
     assert_eq!(film, straight);
 }
 
+/// A film without pixels (a library caller's edge case) takes whole passes
+/// without a panic: zero tiles make zero tasks, not a division by zero.
+#[test]
+fn an_empty_film_takes_whole_passes() {
+    let scene = cornell(16);
+    let mut film = Film::new(0, 0);
+    render_into(&scene, &mut film, 0..40);
+    assert_eq!(film.pass_range(), 0..40);
+}
+
 fn ok(o: &Output) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
