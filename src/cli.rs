@@ -221,7 +221,7 @@ pub struct SettingsArgs {
     /// Wavelength sampling of the spectral integrator.
     #[arg(long, value_enum)]
     pub wavelengths: Option<WavelengthsKind>,
-    /// Wavelengths per packet of the spectral integrator (1, 2, 4 or 8).
+    /// Wavelengths per packet of the spectral integrator, and the wavelengths `auto` draws where a path refracts into dispersive glass (1, 2, 4 or 8).
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4", "8"]).map(|s| s.parse::<u32>().unwrap_or(4)))]
     pub packet_size: Option<u32>,
 }

@@ -43,9 +43,9 @@ pub struct PathTracer {
     /// Whether packets split at dispersive surfaces (the `spectral` and
     /// `auto` integrators); without it every wavelength refracts like 589.3 nm.
     pub disperse: bool,
-    /// The hero packet size a full-spectrum path collapses to at its first
-    /// dispersive surface (`auto`); packets smaller than the full spectrum
-    /// split into all their wavelengths.
+    /// How many wavelengths a full-spectrum path collapses to where it
+    /// refracts at a dispersive surface (`auto`); packets smaller than the
+    /// full spectrum split into all their wavelengths.
     pub collapse_to: u32,
 }
 

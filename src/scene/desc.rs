@@ -85,7 +85,8 @@ pub struct RenderDesc {
     pub integrator: Option<IntegratorKind>,
     /// Wavelength sampling of the `spectral` integrator: `hero`, `random` or `rgb` (default `hero`).
     pub wavelengths: Option<WavelengthsKind>,
-    /// Wavelengths per packet of the `spectral` integrator: 1, 2, 4 or 8 (default 4).
+    /// Wavelengths per packet of the `spectral` integrator, and the wavelengths
+    /// `auto` draws where a path refracts into dispersive glass: 1, 2, 4 or 8 (default 4).
     pub packet_size: Option<u32>,
 }
 
