@@ -162,7 +162,8 @@ pub struct Lambdas<const N: usize> {
     /// Fractional bin positions: `0.0` is 380 nm, `35.0` is 730 nm.
     pub pos: [f32; N],
     /// The weight of each wavelength's contribution (`36 / C` for a packet
-    /// of `C` bins drawn as hero or random; 1 for the full spectrum).
+    /// of `C` bins drawn as hero or random; 1 for the full spectrum;
+    /// `1 / (C · p(bin))` for a wavelength `auto` drew by importance).
     pub weight: f32,
     /// How values become colour.
     pub readout: Readout,
