@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use rust_v::film::Film;
 use rust_v::render::{Limits, TILE_SIZE, render};
-use rust_v::scene::desc::{IntegratorKind, RenderDesc};
+use rust_v::settings::{IntegratorKind, SettingsPatch};
 use rust_v::scene::load_scene;
 
 /// Counts calls to `alloc` and `realloc` (and bytes asked for), then defers to the system allocator.
@@ -71,7 +71,7 @@ fn main() {
     for scene_path in &scenes {
         for integrator in [IntegratorKind::Auto, IntegratorKind::Path, IntegratorKind::Spectral] {
             for size in [64u32, 128] {
-                let overrides = RenderDesc {
+                let overrides = SettingsPatch {
                     width: Some(size),
                     height: Some(size),
                     integrator: Some(integrator),

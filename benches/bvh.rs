@@ -6,8 +6,9 @@
 use glam::Vec3;
 use rand::Rng;
 use rand_pcg::Pcg32;
-use rust_v::bvh::Bvh;
-use rust_v::geometry::{Aabb, Mesh, Ray, Transform};
+use rust_v::shape::Bvh;
+use rust_v::geometry::{Aabb, Ray};
+use rust_v::shape::{Mesh, Transform};
 use std::path::Path;
 use std::time::{Duration, Instant};
 

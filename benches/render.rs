@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
-use rust_v::scene::desc::{IntegratorKind, RenderDesc};
+use rust_v::settings::{IntegratorKind, SettingsPatch};
 use rust_v::scene::load_scene;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -48,7 +48,7 @@ fn main() {
             ("hero-8", IntegratorKind::Spectral, 8),
         ];
         for (name, integrator, packet) in methods {
-            let overrides = RenderDesc {
+            let overrides = SettingsPatch {
                 width: Some(128),
                 height: Some(128),
                 integrator: Some(integrator),

@@ -20,7 +20,8 @@
 //! (`Mesh::face_index`), `inf` and -1 for a miss.
 
 use glam::Vec3;
-use rust_v::geometry::{Mesh, Ray, Transform};
+use rust_v::geometry::Ray;
+use rust_v::shape::{Mesh, Transform};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

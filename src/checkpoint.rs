@@ -24,20 +24,19 @@
 //! Reading checks the magic, the version, the exact length (a truncated
 //! file is reported as such), the checksum, then decodes and validates every
 //! field; any failure is an [`Error::Checkpoint`] naming the file. Writing
-//! goes through [`crate::atomic_file`], so the file on disk is always a
+//! goes through [`crate::io::atomic_file`], so the file on disk is always a
 //! complete old or new checkpoint. bincode is used in this module only.
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 
-use crate::atomic_file::write_atomic;
+use crate::io::write_atomic;
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::scene::Settings;
-use crate::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
+use crate::io::Fnv1a;
+use crate::settings::Settings;
 
 /// The first 8 bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"RUSTVCKP";
@@ -70,19 +69,14 @@ pub struct Checkpoint {
     pub film: Film,
 }
 
+/// The header as encoded. [`Settings`] encodes field by field with its enums
+/// as names, so this is byte for byte the layout format 1 has always had.
 #[derive(Serialize, Deserialize)]
 struct Header {
     crate_version: String,
     scene_path: PathBuf,
     content_hash: u64,
-    width: u32,
-    height: u32,
-    spp: u32,
-    seed: u64,
-    max_bounces: u32,
-    integrator: String,
-    wavelengths: String,
-    packet_size: u32,
+    settings: Settings,
     first_pass: u32,
     end_pass: u32,
     target_end: u32,
@@ -105,17 +99,11 @@ struct Payload {
 
 /// FNV-1a 64-bit over several byte strings in turn.
 fn checksum(parts: &[&[u8]]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut h = Fnv1a::default();
     for part in parts {
-        for &b in *part {
-            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
-        }
+        h.write(part);
     }
-    h
-}
-
-fn value_name<T: ValueEnum>(v: &T) -> String {
-    v.to_possible_value().map(|p| p.get_name().to_owned()).unwrap_or_default()
+    h.finish()
 }
 
 fn u32_at(b: &[u8], at: usize) -> u32 {
@@ -131,22 +119,6 @@ fn u64_at(b: &[u8], at: usize) -> u64 {
 }
 
 impl Checkpoint {
-    /// The settings as scene-loader overrides, so the scene loads exactly as
-    /// it was rendered.
-    pub fn overrides(&self) -> RenderDesc {
-        let s = &self.settings;
-        RenderDesc {
-            width: Some(s.width),
-            height: Some(s.height),
-            spp: Some(s.spp),
-            seed: Some(s.seed),
-            max_bounces: Some(s.max_bounces),
-            integrator: Some(s.integrator),
-            wavelengths: Some(s.wavelengths),
-            packet_size: Some(s.packet_size),
-        }
-    }
-
     /// The passes held.
     pub fn passes(&self) -> Range<u32> {
         self.film.pass_range()
@@ -160,20 +132,12 @@ impl Checkpoint {
     /// The file's bytes with `film` in place of this checkpoint's own (a
     /// render in progress writes its film without copying it).
     pub fn encode_with(&self, film: &Film) -> Result<Vec<u8>> {
-        let s = &self.settings;
         let range = film.pass_range();
         let header = Header {
             crate_version: self.crate_version.clone(),
             scene_path: self.scene_path.clone(),
             content_hash: self.content_hash,
-            width: s.width,
-            height: s.height,
-            spp: s.spp,
-            seed: s.seed,
-            max_bounces: s.max_bounces,
-            integrator: value_name(&s.integrator),
-            wavelengths: value_name(&s.wavelengths),
-            packet_size: s.packet_size,
+            settings: self.settings.clone(),
             first_pass: range.start,
             end_pass: range.end,
             target_end: self.target_end,
@@ -245,30 +209,17 @@ impl Checkpoint {
         if used != header_bytes.len() {
             return Err(bad("corrupt header: trailing bytes".into()));
         }
-        let integrator = IntegratorKind::from_str(&h.integrator, false)
-            .map_err(|_| bad(format!("unknown integrator {:?}", h.integrator)))?;
-        let wavelengths = WavelengthsKind::from_str(&h.wavelengths, false)
-            .map_err(|_| bad(format!("unknown wavelength sampling {:?}", h.wavelengths)))?;
-        if h.width == 0 || h.height == 0 || h.width > 32768 || h.height > 32768 {
-            return Err(bad(format!("invalid image size {}x{}", h.width, h.height)));
+        let settings = h.settings;
+        if let Err((field, message)) = (Settings { spp: settings.spp.max(1), ..settings.clone() }).check() {
+            return Err(bad(format!("corrupt header: {field}: {message}")));
         }
-        if ![1, 2, 4, 8].contains(&h.packet_size) || h.end_pass < h.first_pass {
-            return Err(bad("corrupt header: invalid packet size or pass range".into()));
+        if h.end_pass < h.first_pass {
+            return Err(bad("corrupt header: invalid pass range".into()));
         }
-        let settings = Settings {
-            width: h.width,
-            height: h.height,
-            spp: h.spp,
-            seed: h.seed,
-            max_bounces: h.max_bounces,
-            integrator,
-            wavelengths,
-            packet_size: h.packet_size,
-        };
 
         // The decompressed size is prepended; bound it by what the film can need
         // (17 bytes per varint i128) before allocating.
-        let pixels = h.width as u64 * h.height as u64;
+        let pixels = settings.width as u64 * settings.height as u64;
         let limit = pixels * 3 * 17 + 64;
         if payload_bytes.len() < 4 || u32_at(payload_bytes, 0) as u64 > limit {
             return Err(bad("corrupt payload: implausible size".into()));
@@ -277,7 +228,7 @@ impl Checkpoint {
             .map_err(|e| bad(format!("corrupt payload: does not decompress: {e}")))?;
         let (p, used): (Payload, usize) =
             bincode::serde::decode_from_slice(&raw, config).map_err(|e| bad(format!("corrupt payload: {e}")))?;
-        if used != raw.len() || (p.width, p.height) != (h.width, h.height) {
+        if used != raw.len() || (p.width, p.height) != (settings.width, settings.height) {
             return Err(bad("corrupt payload: size does not match the header".into()));
         }
         let film = Film::from_parts(p.width, p.height, h.first_pass..h.end_pass, p.sums)
@@ -325,20 +276,7 @@ impl Checkpoint {
                 self.content_hash
             ));
         }
-        let (a, b) = (&self.settings, &other.settings);
-        let mut diffs = Vec::new();
-        let mut check = |name: &str, x: String, y: String| {
-            if x != y {
-                diffs.push(format!("{name} {y} vs {x}"));
-            }
-        };
-        check("width", a.width.to_string(), b.width.to_string());
-        check("height", a.height.to_string(), b.height.to_string());
-        check("seed", a.seed.to_string(), b.seed.to_string());
-        check("max_bounces", a.max_bounces.to_string(), b.max_bounces.to_string());
-        check("integrator", value_name(&a.integrator), value_name(&b.integrator));
-        check("wavelengths", value_name(&a.wavelengths), value_name(&b.wavelengths));
-        check("packet_size", a.packet_size.to_string(), b.packet_size.to_string());
+        let diffs = self.settings.differences(&other.settings);
         (!diffs.is_empty()).then(|| format!("different settings: {}", diffs.join(", ")))
     }
 }
@@ -390,7 +328,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
                 ),
             ));
         }
-        merged.film.merge(&c.film).map_err(|e| Error::checkpoint(path, e))?;
+        merged.film.merge(&c.film).map_err(|e| Error::checkpoint(path, e.to_string()))?;
         merged.target_end = merged.target_end.max(c.target_end);
         merged.settings.spp = merged.settings.spp.max(c.settings.spp);
         prev_path = path.clone();

@@ -52,6 +52,9 @@ pub enum Error {
     },
     /// Invalid settings (command line or scene), e.g. a zero width.
     Settings(String),
+    /// Two things that must agree do not (films of different sizes, pass
+    /// ranges that do not follow each other); the caller names the file.
+    Mismatch(String),
 }
 
 impl Error {
@@ -93,7 +96,7 @@ impl fmt::Display for Error {
             Error::Mesh { path, message } => write!(f, "mesh {}: {}", path.display(), message),
             Error::Image { path, message } => write!(f, "image {}: {}", path.display(), message),
             Error::Checkpoint { path, message } => write!(f, "checkpoint {}: {}", path.display(), message),
-            Error::Settings(message) => write!(f, "{message}"),
+            Error::Settings(message) | Error::Mismatch(message) => write!(f, "{message}"),
         }
     }
 }

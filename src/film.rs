@@ -34,14 +34,12 @@
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
 //!   unclamped, for measurements.
 
-use std::io::Cursor;
 use std::ops::Range;
 use std::path::Path;
 
-pub use crate::atomic_file::temp_path;
-use crate::atomic_file::write_atomic;
-use crate::color::{Xyz, srgb_oetf, xyz_to_linear_srgb_f64};
+use crate::color::{Xyz, xyz_to_linear_srgb_f64};
 use crate::error::{Error, Result};
+use crate::io::image::write_linear_srgb;
 
 /// Fractional bits of the fixed-point sums.
 pub const FRAC_BITS: u32 = 64;
@@ -155,17 +153,17 @@ impl Film {
     /// sums does not match the size, the pass range is invalid, or a sum is
     /// larger than its number of passes allows (so later additions cannot
     /// overflow).
-    pub fn from_parts(width: u32, height: u32, passes: Range<u32>, sums: Vec<[i128; 3]>) -> Result<Self, String> {
+    pub fn from_parts(width: u32, height: u32, passes: Range<u32>, sums: Vec<[i128; 3]>) -> Result<Self> {
         if sums.len() != width as usize * height as usize {
-            return Err(format!("{} pixel sums for a {width}x{height} film", sums.len()));
+            return Err(Error::Mismatch(format!("{} pixel sums for a {width}x{height} film", sums.len())));
         }
         if passes.end < passes.start {
-            return Err(format!("invalid pass range {}..{}", passes.start, passes.end));
+            return Err(Error::Mismatch(format!("invalid pass range {}..{}", passes.start, passes.end)));
         }
         let n = passes.end - passes.start;
         let bound = to_fixed(MAX_SAMPLE) * n as i128;
         if let Some(i) = sums.iter().position(|s| s.iter().any(|v| v.unsigned_abs() > bound.unsigned_abs())) {
-            return Err(format!("pixel {i} holds a sum out of range for {n} passes"));
+            return Err(Error::Mismatch(format!("pixel {i} holds a sum out of range for {n} passes")));
         }
         Ok(Film { width, height, sums, first_pass: passes.start, passes: n })
     }
@@ -250,23 +248,23 @@ impl Film {
     /// Adds the passes of `other`, which must be the same size and hold the
     /// passes right after this film's (or this film must be empty). The
     /// result is bit-identical to one render of the combined range.
-    pub fn merge(&mut self, other: &Film) -> Result<(), String> {
+    pub fn merge(&mut self, other: &Film) -> Result<()> {
         if (self.width, self.height) != (other.width, other.height) {
-            return Err(format!(
+            return Err(Error::Mismatch(format!(
                 "a {}x{} film cannot be merged with a {}x{} one",
                 other.width, other.height, self.width, self.height
-            ));
+            )));
         }
         if self.passes == 0 {
             self.first_pass = other.first_pass;
         } else if other.passes > 0 && other.first_pass != self.pass_range().end {
             let (a, b) = (self.pass_range(), other.pass_range());
-            return Err(format!("passes {}..{} do not follow passes {}..{}", b.start, b.end, a.start, a.end));
+            return Err(Error::Mismatch(format!("passes {}..{} do not follow passes {}..{}", b.start, b.end, a.start, a.end)));
         }
-        let passes = self.passes.checked_add(other.passes).ok_or("more than 2^32 passes")?;
+        let passes = self.passes.checked_add(other.passes).ok_or_else(|| Error::Mismatch("more than 2^32 passes".into()))?;
         for (s, o) in self.sums.iter_mut().zip(&other.sums) {
             for c in 0..3 {
-                s[c] = s[c].checked_add(o[c]).ok_or("a pixel sum overflows")?;
+                s[c] = s[c].checked_add(o[c]).ok_or_else(|| Error::Mismatch("a pixel sum overflows".into()))?;
             }
         }
         self.passes = passes;
@@ -284,29 +282,10 @@ impl Film {
         self.mean_xyz().into_iter().map(xyz_to_linear_srgb_f64).collect()
     }
 
-    /// Writes the image: linear EXR if `path` ends in `.exr`, else 16-bit sRGB PNG.
-    /// The file is encoded in memory, written under a temporary name, synced
-    /// and renamed into place, so `path` never holds a partial image.
+    /// Writes the image: linear EXR if `path` ends in `.exr`, else 16-bit sRGB PNG
+    /// ([`crate::io::image::write_linear_srgb`]), atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
-        let is_exr = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-        let rgb = self.linear_srgb();
-        let mut bytes = Cursor::new(Vec::new());
-        let image_error = |e: image::ImageError| Error::Image { path: path.to_path_buf(), message: e.to_string() };
-        let size_error = || Error::Image { path: path.to_path_buf(), message: "buffer size does not match".into() };
-        if is_exr {
-            let data: Vec<f32> = rgb.iter().flat_map(|p| p.map(|v| v as f32)).collect();
-            image::Rgb32FImage::from_raw(self.width, self.height, data)
-                .ok_or_else(size_error)?
-                .write_to(&mut bytes, image::ImageFormat::OpenExr)
-                .map_err(image_error)?;
-        } else {
-            let data: Vec<u16> = rgb.iter().flat_map(|p| p.map(encode_u16)).collect();
-            image::ImageBuffer::<image::Rgb<u16>, Vec<u16>>::from_raw(self.width, self.height, data)
-                .ok_or_else(size_error)?
-                .write_to(&mut bytes, image::ImageFormat::Png)
-                .map_err(image_error)?;
-        }
-        write_atomic(path, &bytes.into_inner())
+        write_linear_srgb(path, self.width, self.height, &self.linear_srgb())
     }
 }
 
@@ -338,13 +317,6 @@ fn add_tile_to_rows(rows: &mut [[i128; 3]], width: u32, first_row: u32, tile: &T
     bad
 }
 
-/// Linear value to a 16-bit sRGB code: clamp to [0, 1], transfer curve, round.
-#[inline]
-pub fn encode_u16(linear: f64) -> u16 {
-    let v = if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) as f32 };
-    (srgb_oetf(v) * 65535.0 + 0.5) as u16
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -362,16 +334,6 @@ mod tests {
             }
             assert!(seen.iter().all(|&c| c == 1), "{w}x{h}");
         }
-    }
-
-    #[test]
-    fn encoding_clamps_and_follows_the_transfer_curve() {
-        assert_eq!(encode_u16(-0.5), 0);
-        assert_eq!(encode_u16(f64::NAN), 0);
-        assert_eq!(encode_u16(2.0), 65535);
-        assert_eq!(encode_u16(1.0), 65535);
-        // 0.5 linear is 0.7354 encoded (IEC 61966-2-1).
-        assert!((encode_u16(0.5) as f64 / 65535.0 - 0.73536).abs() < 1e-4);
     }
 
     #[test]

@@ -22,24 +22,22 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod atomic_file;
-pub mod bvh;
 pub mod bxdf;
 pub mod camera;
-pub mod chart;
 pub mod checkpoint;
 pub mod color;
-pub mod converge;
 pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
+pub mod io;
 pub mod light;
-pub mod metrics;
 pub mod render;
 pub mod sampler;
-pub mod sampling;
 pub mod scene;
+pub mod settings;
+pub mod shape;
 pub mod spectral;
+pub mod study;
 
 pub use error::{Error, Result};

@@ -1,13 +1,11 @@
 //! The `rust-v` binary: parse the command line, run, print errors, exit.
 
 mod cli;
-mod session;
-mod study;
 
 use clap::Parser;
 
 fn main() -> std::process::ExitCode {
-    let cli = cli::Cli::parse();
+    let cli = cli::args::Cli::parse();
     match cli::run(cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

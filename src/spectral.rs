@@ -3,7 +3,7 @@
 //!
 //! Every integrator runs one generic path loop over a packet of `N`
 //! wavelengths ([`Lambdas<N>`]) whose per-wavelength values are a
-//! [`Sampled<N>`] (a fixed-size array the compiler vectorises):
+//! [`Sampled<N>`] ([`crate::color::spectrum`], one arithmetic for every `N`):
 //!
 //! - `N = 36`, the identity packet: the full spectrum, every bin on every path
 //!   (the thesis's "path" tracer, and `auto` where nothing disperses);
@@ -35,9 +35,7 @@
 //! by stratified rotation ([`for_each_rotated`]); each carries the weight
 //! `1 / (C · p(bin))`, which keeps every bin unbiased in the same way.
 
-use std::ops::{Add, AddAssign, Div, Index, Mul, MulAssign};
-
-use crate::color::{self, N_BINS, Spectrum, Xyz};
+use crate::color::{self, N_BINS, Sampled, Spectrum, Xyz};
 
 /// The wavelengths of the RGB mode (thesis §5.2): blue, green, red in nm.
 pub const RGB_LAMBDAS_NM: [f32; 3] = [435.8, 546.1, 700.0];
@@ -45,106 +43,6 @@ pub const RGB_LAMBDAS_NM: [f32; 3] = [435.8, 546.1, 700.0];
 /// The reference wavelength that every wavelength follows at a dispersive
 /// interface in the non-spectral `path` integrator: the sodium D line.
 pub const REFERENCE_LAMBDA_NM: f32 = 589.3;
-
-/// Per-wavelength values of a packet of `N` wavelengths.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Sampled<const N: usize>(pub [f32; N]);
-
-impl<const N: usize> Sampled<N> {
-    /// Every value equal to `v`.
-    #[inline]
-    pub const fn splat(v: f32) -> Self {
-        Sampled([v; N])
-    }
-
-    /// The largest value.
-    #[inline]
-    pub fn max_value(&self) -> f32 {
-        self.0.iter().copied().fold(f32::NEG_INFINITY, f32::max)
-    }
-
-    /// True when every value is zero.
-    #[inline]
-    pub fn is_black(&self) -> bool {
-        self.0.iter().all(|&v| v == 0.0)
-    }
-
-    /// True when any value is NaN or infinite.
-    #[inline]
-    pub fn has_nan_or_inf(&self) -> bool {
-        self.0.iter().any(|v| !v.is_finite())
-    }
-}
-
-impl<const N: usize> Index<usize> for Sampled<N> {
-    type Output = f32;
-    #[inline]
-    fn index(&self, i: usize) -> &f32 {
-        &self.0[i]
-    }
-}
-
-impl<const N: usize> Add for Sampled<N> {
-    type Output = Self;
-    #[inline]
-    fn add(mut self, o: Self) -> Self {
-        self += o;
-        self
-    }
-}
-
-impl<const N: usize> AddAssign for Sampled<N> {
-    #[inline]
-    fn add_assign(&mut self, o: Self) {
-        for i in 0..N {
-            self.0[i] += o.0[i];
-        }
-    }
-}
-
-impl<const N: usize> Mul for Sampled<N> {
-    type Output = Self;
-    #[inline]
-    fn mul(mut self, o: Self) -> Self {
-        self *= o;
-        self
-    }
-}
-
-impl<const N: usize> MulAssign for Sampled<N> {
-    #[inline]
-    fn mul_assign(&mut self, o: Self) {
-        for i in 0..N {
-            self.0[i] *= o.0[i];
-        }
-    }
-}
-
-impl<const N: usize> Mul<f32> for Sampled<N> {
-    type Output = Self;
-    #[inline]
-    fn mul(mut self, s: f32) -> Self {
-        self *= s;
-        self
-    }
-}
-
-impl<const N: usize> MulAssign<f32> for Sampled<N> {
-    #[inline]
-    fn mul_assign(&mut self, s: f32) {
-        for v in &mut self.0 {
-            *v *= s;
-        }
-    }
-}
-
-impl<const N: usize> Div<f32> for Sampled<N> {
-    type Output = Self;
-    #[inline]
-    fn div(self, s: f32) -> Self {
-        self * (1.0 / s)
-    }
-}
 
 /// How a packet's values become a colour.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,12 +1,12 @@
 //! The `auto` integrator (issue 8): exactly `path` where nothing disperses,
 //! and an unbiased spectral estimator where something does.
 
-use rust_v::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
+use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 use crate::common::{mean_and_stderr, render_str, root};
 
-fn with(integrator: IntegratorKind, spp: u32, seed: u64) -> RenderDesc {
-    RenderDesc {
+fn with(integrator: IntegratorKind, spp: u32, seed: u64) -> SettingsPatch {
+    SettingsPatch {
         integrator: Some(integrator),
         spp: Some(spp),
         seed: Some(seed),
@@ -37,7 +37,7 @@ fn auto_matches_spectral_hero_with_dispersion() {
     let auto = crate::spectral::block_stats(&scene, |s| with(IntegratorKind::Auto, 32, 300 + s), 8, 4);
     let hero = crate::spectral::block_stats(
         &scene,
-        |s| RenderDesc { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 32, 400 + s) },
+        |s| SettingsPatch { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 32, 400 + s) },
         8,
         4,
     );
@@ -73,7 +73,7 @@ fn auto_one_spp_is_as_bright_as_converged() {
     let scene = std::fs::read_to_string(root().join("scenes/spheres.ron")).unwrap();
     let converged = render_str(
         &scene,
-        &RenderDesc { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 256, 5) },
+        &SettingsPatch { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 256, 5) },
     );
     let (want, want_se) = mean_and_stderr(&converged, 1);
     let means: Vec<f64> =
@@ -109,7 +109,7 @@ fn auto_matches_hero_from_inside_glass() {
     let auto = crate::spectral::block_stats(scene, |s| with(IntegratorKind::Auto, 16, 500 + s), 8, 4);
     let hero = crate::spectral::block_stats(
         scene,
-        |s| RenderDesc { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 16, 600 + s) },
+        |s| SettingsPatch { wavelengths: Some(WavelengthsKind::Hero), ..with(IntegratorKind::Spectral, 16, 600 + s) },
         8,
         4,
     );

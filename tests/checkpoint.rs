@@ -10,13 +10,13 @@ use std::sync::atomic::AtomicBool;
 use rust_v::checkpoint::{Checkpoint, merge};
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
-use rust_v::scene::desc::RenderDesc;
+use rust_v::settings::SettingsPatch;
 use rust_v::scene::{Scene, load_scene};
 
 use crate::common::{root, rust_v, temp_dir};
 
 fn cornell(size: u32) -> Scene {
-    let o = RenderDesc { width: Some(size), height: Some(size), ..RenderDesc::default() };
+    let o = SettingsPatch { width: Some(size), height: Some(size), ..SettingsPatch::default() };
     load_scene(&root().join("scenes/cornell.ron"), &o).expect("cornell loads")
 }
 

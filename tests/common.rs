@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
-use rust_v::scene::desc::RenderDesc;
+use rust_v::settings::SettingsPatch;
 use rust_v::scene::load_scene_str;
 
 /// The repository root.
@@ -23,7 +23,7 @@ pub fn shared(rel: &str) -> Option<PathBuf> {
 }
 
 /// Renders a scene given as RON text with overrides; returns the film.
-pub fn render_str(ron: &str, overrides: &RenderDesc) -> Film {
+pub fn render_str(ron: &str, overrides: &SettingsPatch) -> Film {
     let scene = load_scene_str(ron, Path::new("test.ron"), overrides).expect("test scene loads");
     let s = &scene.settings;
     let mut film = Film::new(s.width, s.height);

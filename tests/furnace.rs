@@ -3,7 +3,7 @@
 //! and in every direction (the Neumann series L = L_e Σ ρᵏ). This checks the
 //! estimator, light sampling, MIS and Russian roulette together.
 
-use rust_v::scene::desc::RenderDesc;
+use rust_v::settings::SettingsPatch;
 
 use crate::common::{mean_and_stderr, render_str};
 
@@ -25,7 +25,7 @@ fn furnace(material: &str, integrator: &str, rho: f32) -> String {
 /// for the f32 arithmetic; a biased estimator (e.g. roulette without the 1/q
 /// weight, or MIS weights not summing to 1) is off by far more.
 fn check(material: &str, integrator: &str, rho: f32) {
-    let film = render_str(&furnace(material, integrator, rho), &RenderDesc::default());
+    let film = render_str(&furnace(material, integrator, rho), &SettingsPatch::default());
     let want = 1.0 / (1.0 - rho as f64);
     let (mean, se) = mean_and_stderr(&film, 1);
     let tol = 5.0 * se + 2e-3 * want;
@@ -56,10 +56,10 @@ fn spectral_packets_pass_the_furnace() {
     for how in ["hero", "random"] {
         let film = render_str(
             &furnace(material, "spectral", 0.5),
-            &RenderDesc {
+            &SettingsPatch {
                 wavelengths: Some(match how {
-                    "hero" => rust_v::scene::desc::WavelengthsKind::Hero,
-                    _ => rust_v::scene::desc::WavelengthsKind::Random,
+                    "hero" => rust_v::settings::WavelengthsKind::Hero,
+                    _ => rust_v::settings::WavelengthsKind::Random,
                 }),
                 ..Default::default()
             },

@@ -20,9 +20,9 @@ use std::sync::atomic::AtomicBool;
 use rand::Rng;
 use rand_pcg::Pcg32;
 use rust_v::film::Film;
-use rust_v::geometry::{Mesh, Transform};
+use rust_v::shape::{Mesh, Transform};
 use rust_v::render::{Limits, render};
-use rust_v::scene::desc::RenderDesc;
+use rust_v::settings::SettingsPatch;
 use rust_v::scene::load_scene_str;
 
 use crate::common::{root, temp_dir};
@@ -195,8 +195,8 @@ fn clear_error(msg: &str, names: &[&str], what: &dyn Fn() -> String) {
     }
 }
 
-fn overrides() -> RenderDesc {
-    RenderDesc { width: Some(4), height: Some(4), spp: Some(1), ..Default::default() }
+fn overrides() -> SettingsPatch {
+    SettingsPatch { width: Some(4), height: Some(4), spp: Some(1), ..Default::default() }
 }
 
 fn scene_seeds() -> Vec<(String, Vec<u8>)> {

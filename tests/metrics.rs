@@ -1,7 +1,7 @@
 //! Image metrics against independent truths (closed forms, hand-computed values,
 //! properties), and the `compare` and `converge` subcommands through the binary.
 
-use rust_v::metrics::{
+use rust_v::study::metrics::{
     CHANNEL_L, Image, K1, K2, THESIS_L, error_variance, measure, mse16, psnr16, ssim_global, ssim_windowed,
 };
 
@@ -218,7 +218,7 @@ fn converge_writes_csv_and_charts_and_error_falls() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let csv = std::fs::read_to_string(out.join("cornell-converge.csv")).expect("csv written");
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], rust_v::converge::CSV_HEADER);
+    assert_eq!(lines[0], rust_v::study::converge::CSV_HEADER);
     assert_eq!(lines.len(), 1 + 2 * 2 * 3, "2 methods x 2 seeds x 3 checkpoints");
     for stem in ["mse-spp", "mse-seconds", "psnr-spp", "ssim-spp", "variance-spp"] {
         for ext in ["png", "svg"] {

@@ -2,7 +2,7 @@
 //! the invisible glass sphere, and unbiasedness of every wavelength sampler.
 
 use rust_v::film::Film;
-use rust_v::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
+use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 use crate::common::{mean_and_stderr, render_str, root};
 
@@ -12,8 +12,8 @@ use crate::common::{mean_and_stderr, render_str, root};
 const PRISM_COLUMNS: [(usize, f64); 7] =
     [(400, 387.11), (450, 266.33), (500, 192.81), (550, 143.48), (600, 108.22), (650, 81.85), (700, 61.41)];
 
-fn overrides(integrator: IntegratorKind, wavelengths: WavelengthsKind, spp: u32, seed: u64) -> RenderDesc {
-    RenderDesc {
+fn overrides(integrator: IntegratorKind, wavelengths: WavelengthsKind, spp: u32, seed: u64) -> SettingsPatch {
+    SettingsPatch {
         integrator: Some(integrator),
         wavelengths: Some(wavelengths),
         spp: Some(spp),
@@ -100,7 +100,7 @@ fn glass_sphere_in_a_furnace_is_invisible() {
 
 /// Per-block means over `seeds` independent renders: block values and their
 /// standard errors from the seed-to-seed spread.
-pub(crate) fn block_stats(scene: &str, o: impl Fn(u64) -> RenderDesc, seeds: u64, block: usize) -> Vec<(f64, f64)> {
+pub(crate) fn block_stats(scene: &str, o: impl Fn(u64) -> SettingsPatch, seeds: u64, block: usize) -> Vec<(f64, f64)> {
     let films: Vec<Film> = (0..seeds).map(|s| render_str(scene, &o(s))).collect();
     let (w, h) = (films[0].width() as usize, films[0].height() as usize);
     let mut out = Vec::new();
@@ -149,7 +149,7 @@ pub(crate) fn assert_same_image(a: &[(f64, f64)], b: &[(f64, f64)], what: &str) 
 fn spectral_samplers_agree_with_path_without_dispersion() {
     let scene = std::fs::read_to_string(root().join("scenes/cornell-lambert.ron")).unwrap();
     let o = |integrator, wl| {
-        move |s| RenderDesc { width: Some(16), height: Some(16), ..overrides(integrator, wl, 32, 100 + s) }
+        move |s| SettingsPatch { width: Some(16), height: Some(16), ..overrides(integrator, wl, 32, 100 + s) }
     };
     let path = block_stats(&scene, o(IntegratorKind::Path, WavelengthsKind::Hero), 8, 4);
     let hero = block_stats(&scene, o(IntegratorKind::Spectral, WavelengthsKind::Hero), 8, 4);
@@ -164,7 +164,7 @@ fn spectral_samplers_agree_with_path_without_dispersion() {
 fn hero_and_random_agree_with_dispersion() {
     let scene = std::fs::read_to_string(root().join("scenes/spheres.ron")).unwrap();
     let o = |wl| {
-        move |s| RenderDesc {
+        move |s| SettingsPatch {
             width: Some(16),
             height: Some(16),
             ..overrides(IntegratorKind::Spectral, wl, 32, 200 + s)
@@ -182,7 +182,7 @@ fn hero_and_random_agree_with_dispersion() {
 #[test]
 fn one_spp_is_as_bright_as_converged() {
     let scene = std::fs::read_to_string(root().join("scenes/cornell-lambert.ron")).unwrap();
-    let size = |o: RenderDesc| RenderDesc { width: Some(16), height: Some(16), ..o };
+    let size = |o: SettingsPatch| SettingsPatch { width: Some(16), height: Some(16), ..o };
     let converged = render_str(&scene, &size(overrides(IntegratorKind::Path, WavelengthsKind::Hero, 256, 7)));
     let (want, want_se) = image_mean_y(&converged);
     for wl in [WavelengthsKind::Hero, WavelengthsKind::Random] {

@@ -6,14 +6,14 @@
 //! at each test.
 
 use rust_v::film::Film;
-use rust_v::scene::desc::{IntegratorKind, RenderDesc, WavelengthsKind};
+use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 use crate::common::{mean_and_stderr, render_str, temp_dir};
 
 /// The five methods of the failure matrix.
 const METHODS: [&str; 5] = ["whitted", "path", "hero", "random", "auto"];
 
-fn method(m: &str, spp: u32, seed: u64) -> RenderDesc {
+fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
     let (integrator, wavelengths) = match m {
         "whitted" => (IntegratorKind::Whitted, None),
         "path" => (IntegratorKind::Path, None),
@@ -22,7 +22,7 @@ fn method(m: &str, spp: u32, seed: u64) -> RenderDesc {
         "auto" => (IntegratorKind::Auto, None),
         _ => unreachable!(),
     };
-    RenderDesc { integrator: Some(integrator), wavelengths, spp: Some(spp), seed: Some(seed), ..Default::default() }
+    SettingsPatch { integrator: Some(integrator), wavelengths, spp: Some(spp), seed: Some(seed), ..Default::default() }
 }
 
 /// Full-spectrum methods give every sample the same colour for a grey
@@ -323,7 +323,7 @@ fn caustic_scene(light: &str) -> (String, Vec<bool>) {
     use glam::{Vec2, Vec3};
     let eye = Vec3::new(1.5, 1.0, 0.0);
     let cam = rust_v::camera::Camera::new(eye, Vec3::ZERO, Vec3::Y, 25.0, 16, 16);
-    let ball = rust_v::geometry::Sphere::new(Vec3::new(0.0, 0.5, 0.0), 0.3);
+    let ball = rust_v::shape::Sphere::new(Vec3::new(0.0, 0.5, 0.0), 0.3);
     let light = Vec3::new(0.0, 1.5, 0.0);
     let mut shadow = Vec::new();
     for py in 0..16 {
@@ -449,7 +449,7 @@ fn light_inside_glass_is_reached_by_bsdf_sampling_only() {
 #[test]
 fn whitted_misses_indirect_light_in_the_cornell_box() {
     let scene = std::fs::read_to_string(crate::common::root().join("scenes/cornell-lambert.ron")).unwrap();
-    let size = |o: RenderDesc| RenderDesc { width: Some(16), height: Some(16), ..o };
+    let size = |o: SettingsPatch| SettingsPatch { width: Some(16), height: Some(16), ..o };
     let w = y(&render_str(&scene, &size(method("whitted", 64, 13))));
     let p = y(&render_str(&scene, &size(method("path", 64, 14))));
     let top = |v: &[f64]| v[..48].iter().sum::<f64>();
@@ -609,9 +609,9 @@ fn open_cube_obj() -> std::path::PathBuf {
 #[test]
 fn degenerate_triangles_and_meshes_with_holes() {
     let path = open_cube_obj();
-    let mesh = rust_v::geometry::Mesh::load(
+    let mesh = rust_v::shape::Mesh::load(
         &path,
-        &rust_v::geometry::Transform {
+        &rust_v::shape::Transform {
             scale: glam::Vec3::ONE,
             rotate_deg: glam::Vec3::ZERO,
             translate: glam::Vec3::ZERO,

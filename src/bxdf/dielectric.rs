@@ -6,7 +6,11 @@
 //! enters and leaves. No absorption.
 //!
 //! The index of refraction may depend on wavelength ([`Ior`]): then the model
-//! is dispersive, and the integrator asks for one wavelength's direction at a time.
+//! is dispersive ([`super::Dispersion`]), and the integrator asks for one
+//! wavelength's direction at a time. A wavelength arrives in one form, the
+//! packet's fractional bin position ([`Lambdas`]): a packet of one wavelength
+//! refracts at its own index, a larger packet (which reaches a dispersive
+//! surface only when dispersion is off) at the index at 589.3 nm.
 //!
 //! ```ron
 //! "glass": Dielectric(ior: Named("N-BK7")),
@@ -17,8 +21,9 @@
 use glam::Vec3;
 
 use super::{BsdfSample, Ior, fresnel_dielectric, refract};
-use crate::color::{N_BINS, bin_lambda_nm};
-use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM, Sampled};
+use crate::color::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, bin_lambda_nm};
+use crate::color::Sampled;
+use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM};
 
 /// A smooth dielectric; the outside (the side the normal points to) is the
 /// scene's medium, of index 1 (vacuum; see the crate docs).
@@ -53,22 +58,29 @@ impl Dielectric {
         self.reference_ior
     }
 
-    /// The index at wavelength `lambda_nm`, from the table at bin wavelengths.
+    /// The index at fractional bin position `pos` (0 = 380 nm, 35 = 730 nm):
+    /// from the table at bin centres, from the formula between them.
     #[inline]
-    pub fn eta(&self, lambda_nm: f32) -> f32 {
-        let pos = (lambda_nm - crate::color::LAMBDA_MIN_NM) / crate::color::LAMBDA_STEP_NM;
+    pub fn eta_at(&self, pos: f32) -> f32 {
         if pos >= 0.0 && pos.fract() == 0.0 && (pos as usize) < N_BINS {
             self.bin_ior[pos as usize]
         } else {
-            self.ior.at(lambda_nm)
+            self.ior.at(LAMBDA_MIN_NM + LAMBDA_STEP_NM * pos)
         }
+    }
+
+    /// The index a packet refracts at: its wavelength's for a single
+    /// wavelength, the reference wavelength's (589.3 nm) for a larger packet.
+    #[inline]
+    pub fn eta_for<const N: usize>(&self, lambdas: &Lambdas<N>) -> f32 {
+        if N == 1 { self.eta_at(lambdas.pos[0]) } else { self.reference_ior }
     }
 
     /// The Fresnel reflectance at each of the packet's wavelengths, for a
     /// direction `wo` (local frame) outside or inside.
     #[inline]
     pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
-        Sampled(std::array::from_fn(|i| fresnel_dielectric(wo.z, self.eta(lambdas.lambda_nm(i)))))
+        Sampled(std::array::from_fn(|i| fresnel_dielectric(wo.z, self.eta_at(lambdas.pos[i]))))
     }
 
     /// The refraction alone for index `eta`, as a sample of probability 1
@@ -170,16 +182,19 @@ mod tests {
         let ior = crate::bxdf::named_glass("N-SF11").unwrap();
         let d = Dielectric::new(ior.clone());
         for b in 0..N_BINS {
-            assert_eq!(d.eta(bin_lambda_nm(b)), ior.at(bin_lambda_nm(b)));
+            assert_eq!(d.eta_at(b as f32), ior.at(bin_lambda_nm(b)));
         }
-        assert_eq!(d.eta(589.3), ior.at(589.3));
+        assert_eq!(d.eta_at(20.93), ior.at(LAMBDA_MIN_NM + LAMBDA_STEP_NM * 20.93));
         assert_eq!(d.reference_eta(), ior.at(589.3));
+        let one = Lambdas::<1> { pos: [7.0], weight: 1.0, readout: crate::spectral::Readout::Spectral };
+        assert_eq!(d.eta_for(&one), ior.at(450.0));
+        assert_eq!(d.eta_for(&Lambdas::full()), ior.at(589.3));
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let lambdas =
             Lambdas::<4> { pos: [0.0, 9.0, 18.0, 27.0], weight: 9.0, readout: crate::spectral::Readout::Spectral };
         let fr = d.reflectance(wo, &lambdas);
         for i in 0..4 {
-            let eta = d.eta(lambdas.lambda_nm(i));
+            let eta = d.eta_at(lambdas.pos[i]);
             assert_eq!(fr[i], fresnel_dielectric(0.8, eta));
             let forced: BsdfSample<1> = d.sample_refraction(wo, eta).unwrap();
             let sampled: BsdfSample<1> = d.sample(wo, 0.999_999, eta).unwrap();

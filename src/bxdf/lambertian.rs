@@ -10,8 +10,9 @@ use std::f32::consts::FRAC_1_PI;
 
 use super::BsdfSample;
 use crate::color::Spectrum;
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
-use crate::spectral::{Lambdas, Sampled};
+use crate::sampler::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
+use crate::color::Sampled;
+use crate::spectral::Lambdas;
 
 /// Lambertian reflection with a spectral reflectance.
 #[derive(Clone, Debug)]

@@ -13,9 +13,12 @@
 //!   `f · |cos θi| / pdf`, for delta lobes too (they return
 //!   `f = weight / |cos θi|` and `pdf` = the probability of the lobe, as pbrt-v4).
 //! - [`Bxdf::pdf`]`(wo, wi)` is the pdf `sample` would have used (0 for delta).
-//! - A model whose sampled direction depends on wavelength is *dispersive*
-//!   ([`Bxdf::is_dispersive`]); the integrators split wavelength packets before
-//!   sampling it, and pass the single wavelength's index of refraction.
+//! - A model whose sampled direction depends on wavelength is *dispersive*:
+//!   [`Bxdf::dispersion`] says so and how, so the integrators can split
+//!   wavelength packets there without knowing which model it is. A packet of
+//!   one wavelength is sampled at that wavelength; a larger packet at the
+//!   reference wavelength, 589.3 nm (only `path` and `whitted`, which do not
+//!   split, let one reach a dispersive surface).
 //!
 //! Diffuse models are two-sided: they reflect into whichever hemisphere `wo`
 //! is in. The dielectric is oriented: `+z` is outside (the side the geometric
@@ -39,7 +42,8 @@ pub use specular::Mirror;
 
 use glam::{Vec2, Vec3};
 
-use crate::spectral::{Lambdas, Sampled};
+use crate::color::Sampled;
+use crate::spectral::Lambdas;
 
 /// A sampled direction with its value and pdf.
 #[derive(Clone, Copy, Debug)]
@@ -83,24 +87,16 @@ impl Bxdf {
         }
     }
 
-    /// Samples `wi` given `wo`, two uniform numbers `u` and one `uc` (lobe choice).
-    /// `lambda_nm` is the wavelength whose index of refraction a dielectric uses
-    /// (the packet's single wavelength after a split, or the reference wavelength).
+    /// Samples `wi` given `wo`, two uniform numbers `u` and one `uc` (lobe
+    /// choice), for the packet `lambdas` (see the module docs for dispersion).
     #[inline]
-    pub fn sample<const N: usize>(
-        &self,
-        wo: Vec3,
-        u: Vec2,
-        uc: f32,
-        lambdas: &Lambdas<N>,
-        lambda_nm: f32,
-    ) -> Option<BsdfSample<N>> {
+    pub fn sample<const N: usize>(&self, wo: Vec3, u: Vec2, uc: f32, lambdas: &Lambdas<N>) -> Option<BsdfSample<N>> {
         match self {
             Bxdf::Black => None,
             Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
-            Bxdf::Dielectric(m) => m.sample(wo, uc, m.eta(lambda_nm)),
+            Bxdf::Dielectric(m) => m.sample(wo, uc, m.eta_for(lambdas)),
         }
     }
 
@@ -119,19 +115,62 @@ impl Bxdf {
         matches!(self, Bxdf::Mirror(_) | Bxdf::Dielectric(_))
     }
 
+    /// How the model disperses, when `sample`'s direction depends on the
+    /// wavelength; `None` otherwise.
+    #[inline]
+    pub fn dispersion(&self) -> Option<Dispersion<'_>> {
+        match self {
+            Bxdf::Dielectric(d) if d.ior().is_dispersive() => Some(Dispersion(d)),
+            _ => None,
+        }
+    }
+
     /// True when `sample`'s direction depends on the wavelength.
     #[inline]
     pub fn is_dispersive(&self) -> bool {
-        match self {
-            Bxdf::Dielectric(d) => d.ior().is_dispersive(),
-            _ => false,
-        }
+        self.dispersion().is_some()
     }
 
     /// True when the model absorbs everything (a path ends here).
     #[inline]
     pub fn is_black(&self) -> bool {
         matches!(self, Bxdf::Black)
+    }
+}
+
+/// A dispersive model seen by an integrator that splits wavelengths there:
+/// a specular reflection whose direction is the same for every wavelength,
+/// and a refraction whose direction depends on it. [`Bxdf::dispersion`]
+/// hands it out, so integrators never match a model by name.
+#[derive(Clone, Copy, Debug)]
+pub struct Dispersion<'a>(&'a Dielectric);
+
+impl Dispersion<'_> {
+    /// The relative index at the reference wavelength, 589.3 nm.
+    #[inline]
+    pub fn reference_eta(&self) -> f32 {
+        self.0.reference_eta()
+    }
+
+    /// The relative index at fractional bin position `pos`.
+    #[inline]
+    pub fn eta_at(&self, pos: f32) -> f32 {
+        self.0.eta_at(pos)
+    }
+
+    /// The reflectance at each of the packet's wavelengths for `wo`.
+    #[inline]
+    pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
+        self.0.reflectance(wo, lambdas)
+    }
+
+    /// The refraction alone for a single wavelength, as a sample of
+    /// probability 1 whose weight is the radiance scaling `1 / η²` (the
+    /// integrator has already chosen refraction and weighted it); `None` on
+    /// total internal reflection.
+    #[inline]
+    pub fn sample_refraction(&self, wo: Vec3, lambdas: &Lambdas<1>) -> Option<BsdfSample<1>> {
+        self.0.sample_refraction(wo, self.0.eta_for(lambdas))
     }
 }
 
@@ -150,7 +189,7 @@ pub(crate) mod test_util {
         let mut s = Sampler::new(3, 5, 7);
         let mut albedo = Spectrum::ZERO;
         for _ in 0..n {
-            let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l, 550.0) else {
+            let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l) else {
                 continue;
             };
             assert!(bs.pdf > 0.0 && !bs.f.has_nan_or_inf(), "bad sample {bs:?}");
@@ -163,7 +202,7 @@ pub(crate) mod test_util {
                 assert!((b.pdf(wo, bs.wi) - bs.pdf).abs() <= 1e-4 * bs.pdf);
             }
             let w = bs.f * (bs.wi.z.abs() / bs.pdf);
-            albedo += Spectrum(w.0);
+            albedo += w;
         }
         albedo / n as f32
     }

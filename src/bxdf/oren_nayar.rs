@@ -13,7 +13,8 @@ use std::f32::consts::FRAC_1_PI;
 
 use super::{BsdfSample, lambertian};
 use crate::color::Spectrum;
-use crate::spectral::{Lambdas, Sampled};
+use crate::color::Sampled;
+use crate::spectral::Lambdas;
 
 /// Oren-Nayar reflection.
 #[derive(Clone, Debug)]

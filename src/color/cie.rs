@@ -15,7 +15,7 @@
 //! Mitsuba should allow for this ~0.1 % difference.
 
 use super::rgb::Xyz;
-use super::spectrum::N_BINS;
+use super::spectrum::{N_BINS, Spectrum};
 
 /// CIE 1931 2-degree x̄ ȳ z̄ at the 36 bin centres (raw table values).
 ///
@@ -93,6 +93,22 @@ pub const CMF_NORMALISED: [[f32; 3]; N_BINS] = normalise_cmf(&CMF);
 pub fn bin_xyz(i: usize) -> Xyz {
     let [x, y, z] = CMF_NORMALISED[i];
     Xyz::new(x, y, z)
+}
+
+impl Spectrum {
+    /// CIE XYZ of this spectrum: `sum_i self[i] * CMF_NORMALISED[i]`.
+    ///
+    /// With this normalisation the equal-energy spectrum of value 1 has Y = 1.
+    #[inline]
+    pub fn to_xyz(&self) -> Xyz {
+        let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
+        for (&s, cmf) in self.0.iter().zip(CMF_NORMALISED.iter()) {
+            x += s * cmf[0];
+            y += s * cmf[1];
+            z += s * cmf[2];
+        }
+        Xyz::new(x, y, z)
+    }
 }
 
 #[cfg(test)]

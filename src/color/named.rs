@@ -9,7 +9,7 @@
 //! colour-science, tabulated in shared/data/d65_380_730_10nm.csv. Values copied verbatim.
 
 use super::rgb::Xyz;
-use super::spectrum::{N_BINS, Spectrum, bin_lambda_nm};
+use super::spectrum::{N_BINS, Sampled, Spectrum, bin_lambda_nm};
 
 /// Names of the 24 ColorChecker patches, exactly the column headers of the BabelColor CSV, in
 /// chart order (dark skin ... black 2).
@@ -234,7 +234,7 @@ const D65_TABLE: [f32; N_BINS] = [
 ///
 /// The match is exact (case-sensitive), e.g. `"dark skin"`, `"white 9.5 (.05 D)"`.
 pub fn color_checker(name: &str) -> Option<Spectrum> {
-    COLOR_CHECKER_NAMES.iter().position(|&n| n == name).map(|i| Spectrum(COLOR_CHECKER_REFLECTANCE[i]))
+    COLOR_CHECKER_NAMES.iter().position(|&n| n == name).map(|i| Sampled(COLOR_CHECKER_REFLECTANCE[i]))
 }
 
 /// CIE D65 relative SPD sampled at the bins, scaled so that D65(560 nm) = 1.

@@ -1,14 +1,15 @@
-//! The 36-bin spectral quantity used throughout the renderer.
+//! Spectral values and their arithmetic, written once for every packet size.
 //!
-//! Every radiometric quantity (radiance, reflectance, throughput, emission) is carried as a
-//! [`Spectrum`]: 36 samples at the centres of 10 nm bins from 380 nm to 730 nm. Fixed-size,
-//! 32-byte-aligned arrays and plain loops let LLVM auto-vectorise the arithmetic, so the
-//! operators below are deliberately written as simple element-wise loops.
+//! [`Sampled<N>`] holds one value per wavelength of a packet of `N`
+//! wavelengths; [`Spectrum`] is the 36-bin case, `Sampled<36>`: samples at
+//! the centres of 10 nm bins from 380 nm to 730 nm ([`bin_lambda_nm`]).
+//! Every radiometric quantity (radiance, reflectance, throughput, emission)
+//! is one of these. Fixed-size arrays and plain element-wise loops let LLVM
+//! vectorise the arithmetic, so the operators are deliberately simple loops.
+//! Which wavelengths a packet holds is [`crate::spectral`]'s business; the
+//! colour integral of a spectrum is [`super::cie`]'s.
 
 use core::ops::{Add, AddAssign, Div, DivAssign, Index, IndexMut, Mul, MulAssign, Sub, SubAssign};
-
-use super::cie::CMF_NORMALISED;
-use super::rgb::Xyz;
 
 /// Number of spectral bins: 380..=730 nm at 10 nm.
 pub const N_BINS: usize = 36;
@@ -23,224 +24,171 @@ pub fn bin_lambda_nm(i: usize) -> f32 {
     LAMBDA_MIN_NM + LAMBDA_STEP_NM * i as f32
 }
 
-/// A spectral quantity sampled at the [`N_BINS`] bin centres (see [`bin_lambda_nm`]).
+/// Per-wavelength values of a packet of `N` wavelengths.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
-pub struct Spectrum(pub [f32; N_BINS]);
+pub struct Sampled<const N: usize>(pub [f32; N]);
 
-impl Default for Spectrum {
-    /// The zero spectrum.
+/// A spectral quantity sampled at the [`N_BINS`] bin centres (see [`bin_lambda_nm`]).
+pub type Spectrum = Sampled<N_BINS>;
+
+impl<const N: usize> Default for Sampled<N> {
+    /// Zero everywhere.
     #[inline]
     fn default() -> Self {
-        Spectrum::ZERO
+        Self::ZERO
     }
 }
 
-impl Spectrum {
-    /// Zero in every bin.
-    pub const ZERO: Spectrum = Spectrum::splat(0.0);
-    /// One in every bin.
-    pub const ONE: Spectrum = Spectrum::splat(1.0);
+impl<const N: usize> Sampled<N> {
+    /// Zero at every wavelength.
+    pub const ZERO: Self = Self::splat(0.0);
+    /// One at every wavelength.
+    pub const ONE: Self = Self::splat(1.0);
 
-    /// The same value `v` in every bin.
+    /// Every value equal to `v`.
     #[inline]
-    pub const fn splat(v: f32) -> Spectrum {
-        Spectrum([v; N_BINS])
+    pub const fn splat(v: f32) -> Self {
+        Sampled([v; N])
     }
 
-    /// Builds a spectrum from a function of the bin index.
+    /// Values from a function of the index.
     #[inline]
-    pub fn from_fn(f: impl FnMut(usize) -> f32) -> Spectrum {
-        Spectrum(core::array::from_fn(f))
+    pub fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
+        Sampled(core::array::from_fn(f))
     }
 
-    /// Largest bin value.
+    /// The largest value.
     #[inline]
     pub fn max_value(&self) -> f32 {
         self.0.iter().copied().fold(f32::NEG_INFINITY, f32::max)
     }
 
-    /// Smallest bin value.
+    /// The smallest value.
     #[inline]
     pub fn min_value(&self) -> f32 {
         self.0.iter().copied().fold(f32::INFINITY, f32::min)
     }
 
-    /// Arithmetic mean of the bins.
+    /// Arithmetic mean of the values.
     #[inline]
     pub fn average(&self) -> f32 {
-        self.0.iter().sum::<f32>() / N_BINS as f32
+        self.0.iter().sum::<f32>() / N as f32
     }
 
-    /// True if every bin is exactly zero.
+    /// True when every value is exactly zero.
     #[inline]
     pub fn is_black(&self) -> bool {
         self.0.iter().all(|&v| v == 0.0)
     }
 
-    /// True if any bin is NaN or infinite.
+    /// True when any value is NaN or infinite.
     #[inline]
     pub fn has_nan_or_inf(&self) -> bool {
         self.0.iter().any(|v| !v.is_finite())
     }
 
-    /// CIE XYZ of this spectrum: `sum_i self[i] * CMF_NORMALISED[i]`.
-    ///
-    /// With this normalisation the equal-energy spectrum of value 1 has Y = 1 (see
-    /// [`crate::color::cie`]).
+    /// Element-wise `f`.
     #[inline]
-    pub fn to_xyz(&self) -> Xyz {
-        let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
-        for (&s, cmf) in self.0.iter().zip(CMF_NORMALISED.iter()) {
-            x += s * cmf[0];
-            y += s * cmf[1];
-            z += s * cmf[2];
+    pub fn map(mut self, f: impl Fn(f32) -> f32) -> Self {
+        for v in self.0.iter_mut() {
+            *v = f(*v);
         }
-        Xyz::new(x, y, z)
+        self
     }
 
     /// Element-wise square root.
     #[inline]
-    pub fn sqrt(&self) -> Spectrum {
-        let mut out = *self;
-        for v in out.0.iter_mut() {
-            *v = v.sqrt();
-        }
-        out
+    pub fn sqrt(&self) -> Self {
+        self.map(f32::sqrt)
     }
 
     /// Element-wise exponential (e.g. Beer-Lambert transmittance from `-sigma_t * d`).
     #[inline]
-    pub fn exp(&self) -> Spectrum {
-        let mut out = *self;
-        for v in out.0.iter_mut() {
-            *v = v.exp();
-        }
-        out
+    pub fn exp(&self) -> Self {
+        self.map(f32::exp)
     }
 
-    /// Element-wise `max(v, 0)`; NaN bins become 0.
+    /// Element-wise `max(v, 0)`; NaN values become 0.
     #[inline]
-    pub fn clamp_zero(&self) -> Spectrum {
-        let mut out = *self;
-        for v in out.0.iter_mut() {
-            *v = v.max(0.0);
-        }
-        out
+    pub fn clamp_zero(&self) -> Self {
+        self.map(|v| v.max(0.0))
     }
 }
 
-impl Add for Spectrum {
-    type Output = Spectrum;
+/// Element-wise binary operators, each with its assigning form.
+macro_rules! element_wise {
+    ($($op:ident $method:ident $assign:ident $assign_method:ident $sym:tt;)+) => {$(
+        impl<const N: usize> $op for Sampled<N> {
+            type Output = Self;
+            #[inline]
+            fn $method(mut self, rhs: Self) -> Self {
+                self.$assign_method(rhs);
+                self
+            }
+        }
+
+        impl<const N: usize> $assign for Sampled<N> {
+            #[inline]
+            fn $assign_method(&mut self, rhs: Self) {
+                for i in 0..N {
+                    self.0[i] $sym rhs.0[i];
+                }
+            }
+        }
+    )+};
+}
+
+element_wise! {
+    Add add AddAssign add_assign +=;
+    Sub sub SubAssign sub_assign -=;
+    Mul mul MulAssign mul_assign *=;
+    Div div DivAssign div_assign /=;
+}
+
+impl<const N: usize> Mul<f32> for Sampled<N> {
+    type Output = Self;
     #[inline]
-    fn add(mut self, rhs: Spectrum) -> Spectrum {
-        self += rhs;
+    fn mul(mut self, s: f32) -> Self {
+        self *= s;
         self
     }
 }
 
-impl AddAssign for Spectrum {
+impl<const N: usize> Mul<Sampled<N>> for f32 {
+    type Output = Sampled<N>;
     #[inline]
-    fn add_assign(&mut self, rhs: Spectrum) {
-        for i in 0..N_BINS {
-            self.0[i] += rhs.0[i];
-        }
-    }
-}
-
-impl Sub for Spectrum {
-    type Output = Spectrum;
-    #[inline]
-    fn sub(mut self, rhs: Spectrum) -> Spectrum {
-        self -= rhs;
-        self
-    }
-}
-
-impl SubAssign for Spectrum {
-    #[inline]
-    fn sub_assign(&mut self, rhs: Spectrum) {
-        for i in 0..N_BINS {
-            self.0[i] -= rhs.0[i];
-        }
-    }
-}
-
-impl Mul for Spectrum {
-    type Output = Spectrum;
-    #[inline]
-    fn mul(mut self, rhs: Spectrum) -> Spectrum {
-        self *= rhs;
-        self
-    }
-}
-
-impl MulAssign for Spectrum {
-    #[inline]
-    fn mul_assign(&mut self, rhs: Spectrum) {
-        for i in 0..N_BINS {
-            self.0[i] *= rhs.0[i];
-        }
-    }
-}
-
-impl Mul<f32> for Spectrum {
-    type Output = Spectrum;
-    #[inline]
-    fn mul(mut self, rhs: f32) -> Spectrum {
-        self *= rhs;
-        self
-    }
-}
-
-impl Mul<Spectrum> for f32 {
-    type Output = Spectrum;
-    #[inline]
-    fn mul(self, rhs: Spectrum) -> Spectrum {
+    fn mul(self, rhs: Sampled<N>) -> Sampled<N> {
         rhs * self
     }
 }
 
-impl MulAssign<f32> for Spectrum {
+impl<const N: usize> MulAssign<f32> for Sampled<N> {
     #[inline]
-    fn mul_assign(&mut self, rhs: f32) {
-        for i in 0..N_BINS {
-            self.0[i] *= rhs;
+    fn mul_assign(&mut self, s: f32) {
+        for v in &mut self.0 {
+            *v *= s;
         }
     }
 }
 
-impl Div<f32> for Spectrum {
-    type Output = Spectrum;
+/// Division by a scalar multiplies by its reciprocal (one division, then
+/// `N` multiplications).
+impl<const N: usize> Div<f32> for Sampled<N> {
+    type Output = Self;
     #[inline]
-    fn div(mut self, rhs: f32) -> Spectrum {
-        self /= rhs;
-        self
+    fn div(self, s: f32) -> Self {
+        self * (1.0 / s)
     }
 }
 
-impl DivAssign<f32> for Spectrum {
+impl<const N: usize> DivAssign<f32> for Sampled<N> {
     #[inline]
-    fn div_assign(&mut self, rhs: f32) {
-        for i in 0..N_BINS {
-            self.0[i] /= rhs;
-        }
+    fn div_assign(&mut self, s: f32) {
+        *self *= 1.0 / s;
     }
 }
 
-impl Div for Spectrum {
-    type Output = Spectrum;
-    /// Element-wise IEEE division (0/0 gives NaN).
-    #[inline]
-    fn div(mut self, rhs: Spectrum) -> Spectrum {
-        for i in 0..N_BINS {
-            self.0[i] /= rhs.0[i];
-        }
-        self
-    }
-}
-
-impl Index<usize> for Spectrum {
+impl<const N: usize> Index<usize> for Sampled<N> {
     type Output = f32;
     #[inline]
     fn index(&self, i: usize) -> &f32 {
@@ -248,7 +196,7 @@ impl Index<usize> for Spectrum {
     }
 }
 
-impl IndexMut<usize> for Spectrum {
+impl<const N: usize> IndexMut<usize> for Sampled<N> {
     #[inline]
     fn index_mut(&mut self, i: usize) -> &mut f32 {
         &mut self.0[i]
@@ -271,10 +219,9 @@ mod tests {
     }
 
     #[test]
-    fn alignment_is_32() {
-        assert_eq!(core::mem::align_of::<Spectrum>(), 32);
-        // 144 bytes of data padded up to a multiple of the 32-byte alignment.
-        assert_eq!(core::mem::size_of::<Spectrum>(), 160);
+    fn a_spectrum_is_36_floats() {
+        assert_eq!(core::mem::size_of::<Spectrum>(), 144);
+        assert_eq!(core::mem::size_of::<Sampled<4>>(), 16);
     }
 
     #[test]

@@ -1,41 +1,19 @@
-//! Geometry: rays, bounding boxes, hit records and the closed set of shapes the
-//! renderer can intersect (analytic primitives and triangle meshes).
-//!
-//! Every shape answers the same two questions, closest hit and any hit, with
-//! robust floating-point arithmetic so that rays spawned from a hit never
-//! re-hit the surface they leave, at any scene scale.
+//! Geometry maths: rays (with robust spawning), bounding boxes, shading
+//! frames, hit records and floating-point error bounds. The shapes that use
+//! them are in [`crate::shape`].
 
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod bounds;
-pub mod bubble;
-pub mod cuboid;
-pub mod disk;
-pub mod frame;
-pub mod hit;
-pub mod mesh;
-pub mod plane;
-mod ply;
-pub mod quad;
-pub mod ray;
-pub mod shape;
-pub mod sphere;
-pub mod triangle;
+mod bounds;
+mod frame;
+mod hit;
+mod ray;
 
 pub use bounds::Aabb;
-pub use bubble::Bubble;
-pub use cuboid::Cuboid;
-pub use disk::Disk;
 pub use frame::Frame;
 pub use hit::Hit;
-pub use mesh::{Mesh, Transform};
-pub use plane::Plane;
-pub use quad::Quad;
 pub use ray::{Ray, offset_ray_origin};
-pub use shape::Shape;
-pub use sphere::Sphere;
-pub use triangle::Triangle;
 
 /// Half the f32 machine epsilon (the unit roundoff u = 2^-24).
 pub const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;

@@ -31,10 +31,11 @@ use crate::bxdf::Bxdf;
 use crate::color::Xyz;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::Sampler;
-use crate::sampling::power_heuristic;
-use crate::scene::desc::{IntegratorKind, WavelengthsKind};
-use crate::scene::{Scene, Settings};
-use crate::spectral::{Lambdas, Sampled, WavelengthSampling, sample_packet};
+use crate::sampler::warp::power_heuristic;
+use crate::settings::{IntegratorKind, Settings, WavelengthsKind};
+use crate::scene::Scene;
+use crate::color::Sampled;
+use crate::spectral::{Lambdas, WavelengthSampling, sample_packet};
 
 /// Computes the colour of one camera sample. Implementations are chosen once
 /// per render and the render loop is generic over them.

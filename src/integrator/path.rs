@@ -19,15 +19,14 @@
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
-use crate::bxdf::{BsdfSample, Bxdf, Dielectric, fresnel_dielectric};
-use crate::color::N_BINS;
-use crate::color::Xyz;
+use crate::bxdf::{BsdfSample, Dispersion, fresnel_dielectric};
+use crate::color::{N_BINS, Sampled, Xyz};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
-use crate::sampling::power_heuristic;
+use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectral::{
-    BinDistribution, Lambdas, REFERENCE_LAMBDA_NM, Readout, Sampled, bin_importance, for_each_rotated,
+    BinDistribution, Lambdas, Readout, bin_importance, for_each_rotated,
 };
 
 use super::{Shading, sample_direct};
@@ -126,11 +125,13 @@ impl PathTracer {
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             // 3. A dispersive surface splits the packet into single wavelengths.
             let mut reflect = None;
-            if N > 1 && self.disperse && bxdf.is_dispersive() {
+            let dispersion = if self.disperse { bxdf.dispersion() } else { None };
+            if N > 1
+                && let Some(dispersion) = dispersion
+            {
                 if N == N_BINS && lambdas.readout == Readout::Spectral {
                     // `auto`: reflection keeps the full spectrum, refraction collapses.
-                    let Bxdf::Dielectric(glass) = bxdf else { unreachable!("only dielectrics disperse") };
-                    match self.collapse(scene, ray, si, &sh, glass, &w, lambdas, sampler, &mut split) {
+                    match self.collapse(scene, ray, si, &sh, dispersion, &w, lambdas, sampler, &mut split) {
                         Some(fr) => reflect = Some(fr),
                         None => break,
                     }
@@ -149,13 +150,10 @@ impl PathTracer {
             // 5. The next direction.
             let u = sampler.next_2d();
             let uc = sampler.next_1d();
-            let lambda_nm = if N == 1 && self.disperse { lambdas.lambda_nm(0) } else { REFERENCE_LAMBDA_NM };
-            let sample = match (reflect.take(), std::mem::replace(&mut start, Start::Camera), bxdf) {
+            let sample = match (reflect.take(), std::mem::replace(&mut start, Start::Camera), dispersion) {
                 (Some(weight), ..) => Some(mirror(sh.wo, weight)),
-                (None, Start::SplitRefraction, Bxdf::Dielectric(glass)) => {
-                    glass.sample_refraction(sh.wo, glass.eta(lambda_nm))
-                }
-                _ => bxdf.sample(sh.wo, u, uc, lambdas, lambda_nm),
+                (None, Start::SplitRefraction, Some(d)) => refraction(d, sh.wo, lambdas),
+                _ => bxdf.sample(sh.wo, u, uc, lambdas),
             };
             let Some(bs) = sample else {
                 break;
@@ -218,7 +216,7 @@ impl PathTracer {
         ray: Ray,
         si: SurfaceHit,
         sh: &Shading,
-        glass: &Dielectric,
+        glass: Dispersion<'_>,
         w: &Walk<N>,
         lambdas: &Lambdas<N>,
         sampler: &mut Sampler,
@@ -251,7 +249,7 @@ impl PathTracer {
         for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
             let fr = match all_fr {
                 Some(fr) => fr[bin],
-                None => fresnel_dielectric(cos, glass.eta(lambdas.lambda_nm(bin))),
+                None => fresnel_dielectric(cos, glass.eta_at(lambdas.pos[bin])),
             };
             let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
@@ -278,6 +276,15 @@ enum Start {
 fn mirror<const N: usize>(wo: glam::Vec3, weight: Sampled<N>) -> BsdfSample<N> {
     let wi = glam::Vec3::new(-wo.x, -wo.y, wo.z);
     BsdfSample { wi, f: weight / wi.z.abs().max(f32::MIN_POSITIVE), pdf: 1.0, is_delta: true, eta: 1.0 }
+}
+
+/// The forced refraction of a walk split off at a dispersive surface: a
+/// packet of one wavelength, refracting at its own index.
+#[inline]
+fn refraction<const N: usize>(d: Dispersion<'_>, wo: glam::Vec3, lambdas: &Lambdas<N>) -> Option<BsdfSample<N>> {
+    let one = Lambdas { pos: [lambdas.pos[0]], weight: lambdas.weight, readout: lambdas.readout };
+    let s = d.sample_refraction(wo, &one)?;
+    Some(BsdfSample { wi: s.wi, f: Sampled::splat(s.f[0]), pdf: s.pdf, is_delta: s.is_delta, eta: s.eta })
 }
 
 /// The packet-independent part of a walk's state, for a split.

@@ -6,13 +6,15 @@
 //! sample and stop. Emitters are seen directly or through specular chains.
 //! Indirect diffuse light and caustics are missing by construction: that is the
 //! method's documented shortfall, not a bug. Dispersive glass refracts every
-//! wavelength like 589.3 nm (no rainbow), as in the `path` integrator.
+//! wavelength like 589.3 nm (no rainbow), as in the `path` integrator: its
+//! packets are the full spectrum, which a BxDF samples at that wavelength.
 
 use crate::color::Xyz;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM, Sampled};
+use crate::color::Sampled;
+use crate::spectral::Lambdas;
 
 use super::{Shading, sample_direct};
 
@@ -52,7 +54,7 @@ impl Whitted {
             }
             let u = sampler.next_2d();
             let uc = sampler.next_1d();
-            let Some(bs) = bxdf.sample(sh.wo, u, uc, lambdas, REFERENCE_LAMBDA_NM) else {
+            let Some(bs) = bxdf.sample(sh.wo, u, uc, lambdas) else {
                 break;
             };
             let wi = sh.frame.to_world(bs.wi);

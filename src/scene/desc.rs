@@ -26,6 +26,8 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+use crate::settings::SettingsPatch;
+
 /// A 3-vector in the file: `(x, y, z)`.
 pub type V3 = [f32; 3];
 
@@ -37,7 +39,7 @@ pub struct SceneDesc {
     pub camera: CameraDesc,
     /// Render settings; each can be overridden on the command line.
     #[serde(default)]
-    pub render: RenderDesc,
+    pub render: SettingsPatch,
     /// Named materials, referred to by objects.
     #[serde(default)]
     pub materials: BTreeMap<String, MaterialDesc>,
@@ -65,55 +67,6 @@ pub struct CameraDesc {
 
 fn default_up() -> V3 {
     [0.0, 1.0, 0.0]
-}
-
-/// Render settings of a scene file (all optional).
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RenderDesc {
-    /// Image width in pixels (default 512).
-    pub width: Option<u32>,
-    /// Image height in pixels (default 512).
-    pub height: Option<u32>,
-    /// Samples per pixel = passes (default 64).
-    pub spp: Option<u32>,
-    /// Random seed (default 0).
-    pub seed: Option<u64>,
-    /// Maximum number of scattering events on a path (default 8); see the crate docs.
-    pub max_bounces: Option<u32>,
-    /// Integrator: `auto`, `path`, `whitted` or `spectral` (default `auto`).
-    pub integrator: Option<IntegratorKind>,
-    /// Wavelength sampling of the `spectral` integrator: `hero`, `random` or `rgb` (default `hero`).
-    pub wavelengths: Option<WavelengthsKind>,
-    /// Wavelengths per packet of the `spectral` integrator, and the wavelengths
-    /// `auto` draws where a path refracts into dispersive glass: 1, 2, 4 or 8 (default 4).
-    pub packet_size: Option<u32>,
-}
-
-/// The integrators.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum IntegratorKind {
-    /// The default: full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
-    Auto,
-    /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
-    Path,
-    /// Whitted-style recursive ray tracing: E S* (D|G) L.
-    Whitted,
-    /// Spectral path tracing with wavelength packets that split at dispersive surfaces.
-    Spectral,
-}
-
-/// Wavelength sampling of the spectral integrator.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum WavelengthsKind {
-    /// One uniform hero bin, the others at equal rotation.
-    Hero,
-    /// Independent uniform bins.
-    Random,
-    /// Three fixed wavelengths (435.8, 546.1, 700 nm) read out as RGB.
-    Rgb,
 }
 
 /// A spectrum in the scene file.

@@ -7,13 +7,14 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::desc::{IorDesc, LightDesc, MaterialDesc, RenderDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
-use super::{Object, Scene, Settings};
+use super::desc::{IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
+use super::{Object, Scene};
 use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, OrenNayar, named_glass};
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
-use crate::geometry::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
+use crate::settings::{Settings, SettingsPatch};
+use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
 use crate::light::Light;
 
 /// The largest coordinate or size a scene may give: squares and products of a few
@@ -23,14 +24,14 @@ pub const MAX_MAGNITUDE: f32 = 1e15;
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
 /// precedence over the file's `render` settings.
-pub fn load_scene(path: &Path, overrides: &RenderDesc) -> Result<Scene> {
+pub fn load_scene(path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     load_scene_str(&text, path, overrides)
 }
 
 /// Loads a scene from its text; `path` names it in errors and anchors
 /// relative mesh paths.
-pub fn load_scene_str(text: &str, path: &Path, overrides: &RenderDesc) -> Result<Scene> {
+pub fn load_scene_str(text: &str, path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
     let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
     let desc: SceneDesc = options.from_str(text).map_err(|e| Error::Scene {
         path: path.to_path_buf(),
@@ -234,7 +235,7 @@ impl Ctx<'_> {
     }
 }
 
-fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &RenderDesc, content_hash: u64) -> Result<Scene> {
+fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash: u64) -> Result<Scene> {
     let settings = settings(ctx, &desc.render, overrides)?;
 
     // Materials by name; index 0 is the implicit black material of lights.
@@ -304,29 +305,9 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &RenderDesc, content_hash: u
     Ok(Scene::new(objects, materials, lights, camera, settings, content_hash))
 }
 
-/// Combines defaults, the file's `render` block and the command line.
-fn settings(ctx: &Ctx<'_>, file: &RenderDesc, cli: &RenderDesc) -> Result<Settings> {
-    let d = Settings::default();
-    let s = Settings {
-        width: cli.width.or(file.width).unwrap_or(d.width),
-        height: cli.height.or(file.height).unwrap_or(d.height),
-        spp: cli.spp.or(file.spp).unwrap_or(d.spp),
-        seed: cli.seed.or(file.seed).unwrap_or(d.seed),
-        max_bounces: cli.max_bounces.or(file.max_bounces).unwrap_or(d.max_bounces),
-        integrator: cli.integrator.or(file.integrator).unwrap_or(d.integrator),
-        wavelengths: cli.wavelengths.or(file.wavelengths).unwrap_or(d.wavelengths),
-        packet_size: cli.packet_size.or(file.packet_size).unwrap_or(d.packet_size),
-    };
-    for (name, v) in [("width", s.width), ("height", s.height), ("spp", s.spp)] {
-        if v == 0 {
-            return Err(ctx.err(format!("render.{name}"), "expected a positive number, found 0"));
-        }
-    }
-    if s.width > 1 << 15 || s.height > 1 << 15 {
-        return Err(ctx.err("render.width", "expected at most 32768 pixels per side"));
-    }
-    if ![1, 2, 4, 8].contains(&s.packet_size) {
-        return Err(ctx.err("render.packet_size", format!("expected 1, 2, 4 or 8, found {}", s.packet_size)));
-    }
+/// Combines defaults, the file's `render` block and the command line, and checks the result.
+fn settings(ctx: &Ctx<'_>, file: &SettingsPatch, cli: &SettingsPatch) -> Result<Settings> {
+    let s = Settings::combine(file, cli);
+    s.check().map_err(|(field, message)| ctx.err(format!("render.{field}"), message))?;
     Ok(s)
 }

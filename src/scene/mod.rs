@@ -12,12 +12,13 @@ mod load;
 
 pub use load::{load_scene, load_scene_str};
 
-use crate::bvh::Bvh;
+use crate::shape::Bvh;
 use crate::bxdf::Bxdf;
 use crate::camera::Camera;
-use crate::geometry::{Hit, Ray, Shape};
+use crate::geometry::{Hit, Ray};
+use crate::shape::Shape;
 use crate::light::Light;
-use desc::{IntegratorKind, WavelengthsKind};
+use crate::settings::Settings;
 
 /// Below this many bounded objects the scene tests them one by one instead of
 /// building a BVH over them. Measured with callgrind (instructions for a 32x32,
@@ -35,42 +36,6 @@ pub struct Object {
     pub material: u32,
     /// Index into [`Scene::lights`] when the object emits.
     pub light: Option<u32>,
-}
-
-/// Render settings after the scene file and the command line are combined.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Settings {
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
-    /// Samples per pixel (= passes).
-    pub spp: u32,
-    /// Seed of the deterministic sampler.
-    pub seed: u64,
-    /// Maximum number of scattering events on a path.
-    pub max_bounces: u32,
-    /// The integrator.
-    pub integrator: IntegratorKind,
-    /// Wavelength sampling (spectral integrator).
-    pub wavelengths: WavelengthsKind,
-    /// Wavelengths per packet (spectral integrator).
-    pub packet_size: u32,
-}
-
-impl Default for Settings {
-    fn default() -> Self {
-        Settings {
-            width: 512,
-            height: 512,
-            spp: 64,
-            seed: 0,
-            max_bounces: 8,
-            integrator: IntegratorKind::Auto,
-            wavelengths: WavelengthsKind::Hero,
-            packet_size: 4,
-        }
-    }
 }
 
 /// The closest hit of a ray in the scene.

@@ -1,6 +1,6 @@
 //! Infinite planes (unbounded, so they live outside the scene BVH).
 
-use super::{Hit, Ray};
+use crate::geometry::{Hit, Ray};
 use glam::Vec3;
 
 /// The infinite plane through `point` with unit normal `normal` (the same normal on both sides).
@@ -55,7 +55,7 @@ impl Plane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
 
     #[test]

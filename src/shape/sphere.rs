@@ -1,7 +1,7 @@
 //! Spheres, intersected with the numerically stable quadratic and hit points
 //! re-projected onto the surface (so spawned rays do not re-hit it).
 
-use super::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use glam::Vec3;
 
 /// A solid sphere; its normal points outward.

@@ -1,16 +1,17 @@
-//! Triangle meshes: loading (.obj via tobj, .ply via our reader, either optionally
-//! gzip-compressed), placement by a [`Transform`], and intersection through the
+//! Triangle meshes: loading (through [`crate::io::mesh_file`]: .obj, .ply, either
+//! optionally gzip-compressed), placement by a [`Transform`], and intersection through the
 //! mesh's own [`Bvh`]. Triangles are stored in BVH leaf order, so the triangles of
 //! a leaf are contiguous in memory; `Hit::prim` is a triangle's index in that order.
 
-use super::ply;
-use super::triangle::TriRay;
-use super::{Aabb, Hit, Ray};
-use crate::bvh::Bvh;
-use crate::error::{Error, Result};
-use glam::{Mat3, Vec3};
-use std::io::Read;
 use std::path::Path;
+
+use glam::{Mat3, Vec3};
+
+use super::bvh::Bvh;
+use super::triangle::TriRay;
+use crate::error::{Error, Result};
+use crate::geometry::{Aabb, Hit, Ray};
+use crate::io::mesh_file::{MeshData, read_mesh_file};
 
 /// Placement of a mesh: scale, then rotate about X, then Y, then Z (degrees), then
 /// translate. The default is the identity.
@@ -75,8 +76,8 @@ impl Mesh {
     /// with no valid triangle, an out-of-range index, a non-finite coordinate or a
     /// singular transform is an error naming the file.
     pub fn load(path: &Path, transform: &Transform) -> Result<Mesh> {
-        let (positions, indices, normals) = read_file(path)?;
-        Mesh::build(positions, indices, normals, transform, &|m| Error::mesh(path, m))
+        let MeshData { positions, triangles, normals } = read_mesh_file(path)?;
+        Mesh::build(positions, triangles, normals, transform, &|m| Error::mesh(path, m))
     }
 
     /// The raw contents of a mesh file as [`Mesh::load`] reads them, before any transform
@@ -84,8 +85,8 @@ impl Mesh {
     /// fan-triangulated, OBJ triangulated by tobj) in file order, degenerate triangles
     /// included. Triangle `i` here is what [`Mesh::face_index`] refers to.
     pub fn read_arrays(path: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>)> {
-        let (positions, indices, _) = read_file(path)?;
-        Ok((positions, indices))
+        let MeshData { positions, triangles, .. } = read_mesh_file(path)?;
+        Ok((positions, triangles))
     }
 
     /// A mesh from positions, triangles (indices into `positions`, counter-clockwise
@@ -250,82 +251,11 @@ impl Mesh {
     }
 }
 
-/// Reads and decompresses a mesh file into positions, triangles and optional normals.
-fn read_file(path: &Path) -> Result<Loaded> {
-    let raw = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
-    let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
-        let mut out = Vec::with_capacity(raw.len() * 4);
-        flate2::read::MultiGzDecoder::new(raw.as_slice())
-            .read_to_end(&mut out)
-            .map_err(|e| Error::mesh(path, format!("gzip decompression failed: {e}")))?;
-        (out, stem.to_string())
-    } else {
-        (raw, name)
-    };
-    if name.ends_with(".ply") {
-        let d = ply::parse(&data, path)?;
-        Ok((d.positions, d.triangles, d.normals))
-    } else if name.ends_with(".obj") {
-        load_obj(&data, path)
-    } else {
-        Err(Error::mesh(path, "unknown mesh format: expected a name ending in .obj, .ply, .obj.gz or .ply.gz"))
-    }
-}
-
-type Loaded = (Vec<Vec3>, Vec<[u32; 3]>, Option<Vec<Vec3>>);
-
-/// Reads an OBJ file (all its objects and groups merged) with tobj, triangulated, with
-/// one index per vertex so that normals line up with positions.
-fn load_obj(data: &[u8], path: &Path) -> Result<Loaded> {
-    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let mut reader = std::io::BufReader::new(data);
-    // tobj multiplies face indices without overflow checks: a huge index (e.g. a
-    // relative -2147483649) panics in builds with overflow checks. Turn that into an error.
-    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
-    }))
-    .map_err(|_| Error::mesh(path, "OBJ parse error: index out of range (the OBJ parser panicked)"))?;
-    let (models, _materials) = parsed.map_err(|e| Error::mesh(path, format!("OBJ parse error: {e}")))?;
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    let mut normals = Vec::new();
-    let mut all_normals = true;
-    for model in &models {
-        let m = &model.mesh;
-        let base = positions.len() as u32;
-        let nv = m.positions.len() / 3;
-        positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
-        if m.normals.len() == m.positions.len() {
-            normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
-        } else {
-            all_normals = false;
-        }
-        if m.indices.len() % 3 != 0 {
-            return Err(Error::mesh(
-                path,
-                format!("object '{}': {} indices is not a multiple of 3", model.name, m.indices.len()),
-            ));
-        }
-        for c in m.indices.chunks_exact(3) {
-            if let Some(&bad) = c.iter().find(|&&i| i as usize >= nv) {
-                return Err(Error::mesh(
-                    path,
-                    format!("object '{}': vertex index {} out of range ({nv} vertices)", model.name, bad + 1),
-                ));
-            }
-            indices.push([base + c[0], base + c[1], base + c[2]]);
-        }
-    }
-    let normals = (all_normals && !normals.is_empty()).then_some(normals);
-    Ok((positions, indices, normals))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Triangle;
-    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use crate::shape::Triangle;
+    use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
     use std::io::Write;
     use std::path::PathBuf;

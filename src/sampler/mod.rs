@@ -1,4 +1,6 @@
-//! The deterministic per-sample random number source.
+//! Sampling: the deterministic per-sample random number source
+//! ([`Sampler`]) and the warps from uniform numbers to directions and points
+//! ([`warp`]).
 //!
 //! Every camera sample draws its random numbers from a PCG32 stream keyed by
 //! `(seed, pixel, pass)`: the stream's state and increment are hashes of
@@ -7,6 +9,8 @@
 //! this process; that is what makes renders bit-identical across thread
 //! counts, and resume and merge exact. Dimensions are consumed in the fixed
 //! order the integrator asks for them.
+
+pub mod warp;
 
 use glam::Vec2;
 use rand::Rng;

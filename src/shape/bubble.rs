@@ -3,7 +3,7 @@
 //! from the centre, the inner surface's normal towards it (out of the shell, into the cavity).
 
 use super::sphere::{first_root, reproject, sphere_roots};
-use super::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use glam::Vec3;
 
 /// A spherical shell of radii `inner_radius < outer_radius` around `center`.

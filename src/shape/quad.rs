@@ -2,7 +2,7 @@
 //! normal `normalize(edge_u x edge_v)` (the same on both sides). Typical area lights.
 
 use super::plane::plane_t;
-use super::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use glam::Vec3;
 
 /// A parallelogram, with the plane and the coordinate projection precomputed
@@ -78,7 +78,7 @@ impl Quad {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
 
     #[test]

@@ -487,8 +487,8 @@ fn partition(prims: &mut [BuildPrim], left: impl Fn(&BuildPrim) -> bool) -> usiz
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Triangle;
-    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use crate::shape::Triangle;
+    use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
 
     fn soup(n: usize, seed: u64) -> Vec<Triangle> {

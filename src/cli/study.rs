@@ -1,23 +1,24 @@
 //! The `compare` and `converge` subcommands: image metrics and convergence studies.
 //!
-//! The measuring is in the library ([`rust_v::metrics`], [`rust_v::converge`],
-//! [`rust_v::chart`]); this module reads the flags, prints, and names the output files.
+//! The measuring is in the library ([`rust_v::study`]); this module reads the
+//! flags, prints, and names the output files.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use rust_v::chart::{self, Chart, Series};
-use rust_v::converge::{self, Method, Record, SUMMARY_METRICS, Schedule, Summary};
 use rust_v::error::{Error, Result};
-use rust_v::metrics::{Image, Metrics, Source, THESIS_L, firefly_share, measure};
 use rust_v::scene::load_scene;
+use rust_v::study::chart::{self, Chart, Series};
+use rust_v::study::converge::{self, Method, Record, SUMMARY_METRICS, Schedule, Summary};
+use rust_v::study::metrics::{Image, Metrics, Ratios, Source, THESIS_L, firefly_share, measure};
 
-use crate::cli::{CompareArgs, ConvergeArgs, thread_pool};
+use super::args::{CompareArgs, ConvergeArgs};
+use super::console::thread_pool;
 
 /// Reads both images and measures `a` against `b`; errors name the file(s).
-pub fn compare_files(a: &Path, b: &Path) -> Result<(Image, Image, Metrics)> {
+fn compare_files(a: &Path, b: &Path) -> Result<(Image, Image, Metrics)> {
     let ia = Image::read(a)?;
     let ib = Image::read(b)?;
     if (ia.width, ia.height) != (ib.width, ib.height) {
@@ -253,7 +254,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
         written.push(stem.with_extension("png"));
     }
     if !ratios.is_empty() {
-        let pts = |f: &dyn Fn(&rust_v::metrics::Ratios) -> f64| {
+        let pts = |f: &dyn Fn(&Ratios) -> f64| {
             ratios.iter().map(|(spp, r)| (*spp as f64, f(r), f(r), f(r))).collect::<Vec<_>>()
         };
         let s = vec![

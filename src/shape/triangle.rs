@@ -5,7 +5,7 @@
 //! least one of the triangles sharing it. Exactly-zero edge functions are redone
 //! in f64. Degenerate triangles give det = 0 and miss, with no NaN.
 
-use super::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use glam::Vec3;
 
 /// A single triangle; its geometric normal is `normalize((v1 - v0) x (v2 - v0))`.
@@ -142,7 +142,7 @@ impl Triangle {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::sphere::tests::{random_dir, uniform};
+    use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
 
     #[test]

@@ -1,7 +1,7 @@
 //! Disks: flat circles, one-sided normal given by the user (the same on both sides).
 
 use super::plane::{plane_t, project};
-use super::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use glam::Vec3;
 
 /// A disk of radius `radius` around `center` in the plane with unit normal `normal`.

@@ -1,7 +1,37 @@
-//! The closed set of shapes a scene object can have, dispatched with `match`
-//! (no trait objects, no allocation on the per-ray path).
+//! Shapes: the closed set of surfaces a scene object can have, one file per
+//! shape, and the BVH that meshes and scenes build over them.
+//!
+//! [`Shape`] dispatches with `match` (no trait objects, no allocation on the
+//! per-ray path). Every shape answers the same two questions, closest hit and
+//! any hit, with robust floating-point arithmetic (the maths is in
+//! [`crate::geometry`]), so that rays spawned from a hit never re-hit the
+//! surface they leave, at any scene scale. A new shape is a new file here,
+//! a variant of [`Shape`] and a variant of the scene format's `ShapeDesc`.
 
-use super::{Aabb, Bubble, Cuboid, Disk, Hit, Mesh, Plane, Quad, Ray, Sphere};
+// `!(x > 0.0)` is used on purpose: it is also true for NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+mod bubble;
+mod bvh;
+mod cuboid;
+mod disk;
+mod mesh;
+mod plane;
+mod quad;
+mod sphere;
+mod triangle;
+
+pub use bubble::Bubble;
+pub use bvh::Bvh;
+pub use cuboid::Cuboid;
+pub use disk::Disk;
+pub use mesh::{Mesh, Transform};
+pub use plane::Plane;
+pub use quad::Quad;
+pub use sphere::Sphere;
+pub use triangle::Triangle;
+
+use crate::geometry::{Aabb, Hit, Ray};
 
 /// Any shape of the renderer.
 #[derive(Clone, Debug)]

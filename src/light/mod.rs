@@ -18,8 +18,9 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 use crate::color::Spectrum;
-use crate::geometry::{Disk, Frame, Sphere};
-use crate::sampling::{concentric_disk, uniform_sphere};
+use crate::geometry::Frame;
+use crate::shape::{Disk, Sphere};
+use crate::sampler::warp::{concentric_disk, uniform_sphere};
 
 /// The closed set of lights.
 #[derive(Clone, Debug)]
@@ -231,7 +232,7 @@ mod tests {
         let mut s = Sampler::new(seed, 1, 1);
         let mut integral = 0.0f64;
         for _ in 0..n {
-            let w = crate::sampling::uniform_sphere(s.next_2d());
+            let w = crate::sampler::warp::uniform_sphere(s.next_2d());
             if let Some(h) = hit(&Ray::new(p, w)) {
                 integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
             }

@@ -5,7 +5,7 @@
 //! `rust-v converge` calls [`run`] once per method and seed, writes the records with
 //! [`write_records`], their spread over seeds with [`summarise`] /
 //! [`write_summary`], the hero/random ratios with [`ratios`], and draws the charts
-//! ([`crate::chart`]).
+//! ([`super::chart`]).
 //!
 //! Timing: the render is split into segments between checkpoints (a render of
 //! passes `a..b` is exactly that part of a longer render, see [`crate::render`]), and
@@ -20,10 +20,10 @@ use std::time::Duration;
 
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::metrics::{Image, Metrics, Ratios, measure};
+use super::metrics::{Image, Metrics, Ratios, measure};
 use crate::render::{Limits, render};
 use crate::scene::Scene;
-use crate::scene::desc::{IntegratorKind, WavelengthsKind};
+use crate::settings::{IntegratorKind, WavelengthsKind};
 
 /// A rendering method of a study: an integrator and, for the spectral one, a
 /// wavelength sampling.

@@ -9,7 +9,7 @@
 //!   by the Euclidean distance Δ (eq. 4.1). [`mse16`] (eq. 4.6), [`psnr16`] (eq. 4.7,
 //!   with `L = |(65535, 65535, 65535)|` = [`THESIS_L`]), [`ssim_global`] (eq. 4.8) and
 //!   [`error_variance`] (Figure 5.2d) work on them. For an EXR the codes are made as
-//!   our PNG output makes them ([`crate::film::encode_u16`]: clamp to [0, 1], sRGB
+//!   our PNG output makes them ([`crate::io::image::encode_u16`]: clamp to [0, 1], sRGB
 //!   curve, round); for a PNG they are the file's values (8-bit values scaled by 257).
 //! - **Linear sRGB** values, on which [`mse_linear`], [`relmse`] and the mean relative
 //!   errors work, defined as in the Mitsuba 3 peer harness (`common.py`) so the numbers
@@ -24,7 +24,8 @@ use std::path::Path;
 
 use crate::color::srgb_eotf;
 use crate::error::{Error, Result};
-use crate::film::{Film, encode_u16};
+use crate::film::Film;
+use crate::io::image::{Pixels, encode_u16, read_image};
 
 /// The thesis' maximum signal, `L = |(65535, 65535, 65535)| = 65535 √3` (eq. 4.5).
 pub const THESIS_L: f64 = 113_509.949_674_026_37;
@@ -86,28 +87,10 @@ impl Image {
 
     /// Reads a PNG (8 or 16 bits per channel) or an EXR (linear sRGB floats).
     pub fn read(path: &Path) -> Result<Image> {
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| Error::io(path, e))?
-            .with_guessed_format()
-            .map_err(|e| Error::io(path, e))?;
-        let bad = |message: String| Error::Image { path: path.to_path_buf(), message };
-        let format = reader.format();
-        let img = reader.decode().map_err(|e| bad(format!("cannot decode: {e}")))?;
-        match format {
-            Some(image::ImageFormat::OpenExr) => {
-                let rgb = img.into_rgb32f();
-                let (w, h) = rgb.dimensions();
-                let linear = rgb.pixels().map(|p| p.0.map(f64::from)).collect();
-                Ok(Image::from_linear(w, h, linear))
-            }
-            Some(image::ImageFormat::Png) => {
-                let rgb = img.into_rgb16();
-                let (w, h) = rgb.dimensions();
-                let codes: Vec<[u16; 3]> = rgb.pixels().map(|p| p.0).collect();
-                Ok(Image::from_code16(w, h, &codes))
-            }
-            other => Err(bad(format!("expected a PNG or EXR image, found {other:?}"))),
-        }
+        Ok(match read_image(path)? {
+            (w, h, Pixels::Linear(linear)) => Image::from_linear(w, h, linear),
+            (w, h, Pixels::Code16(codes)) => Image::from_code16(w, h, &codes),
+        })
     }
 
     /// Number of pixels.

@@ -24,7 +24,7 @@ use crate::error::{Error, Result};
 /// Pixel size of the PNG charts (the SVGs have the same size in user units).
 pub const CHART_SIZE: (u32, u32) = (900, 600);
 
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
 /// One line of a chart: points `(x, min, median, max)`; the line goes through the medians.
@@ -76,16 +76,16 @@ pub fn draw(stem: &Path, chart: &Chart, series: &[Series]) -> Result<()> {
     });
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
-    let fail = |path: &Path, e: String| Error::Image { path: path.to_path_buf(), message: format!("chart: {e}") };
+    let fail = |path: &Path, e: &dyn std::fmt::Display| Error::Image { path: path.to_path_buf(), message: format!("chart: {e}") };
     {
         let root = BitMapBackend::new(&png, CHART_SIZE).into_drawing_area();
-        draw_on(&root, chart, series).map_err(|e| fail(&png, e))?;
-        root.present().map_err(|e| fail(&png, e.to_string()))?;
+        draw_on(&root, chart, series).map_err(|e| fail(&png, &e))?;
+        root.present().map_err(|e| fail(&png, &e))?;
     }
     {
         let root = SVGBackend::new(&svg, CHART_SIZE).into_drawing_area();
-        draw_on(&root, chart, series).map_err(|e| fail(&svg, e))?;
-        root.present().map_err(|e| fail(&svg, e.to_string()))?;
+        draw_on(&root, chart, series).map_err(|e| fail(&svg, &e))?;
+        root.present().map_err(|e| fail(&svg, &e))?;
     }
     Ok(())
 }
@@ -109,8 +109,11 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> Range<f64> {
     }
 }
 
-fn draw_on<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart, series: &[Series]) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+/// What drawing on backend `DB` can fail with.
+type DrawResult<DB> = std::result::Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+
+fn draw_on<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart, series: &[Series]) -> DrawResult<DB> {
+    root.fill(&WHITE)?;
     let xs = range(series.iter().flat_map(|s| s.points.iter().map(|p| p.0)), true);
     let ys = series.iter().flat_map(|s| s.points.iter().flat_map(|p| [p.1, p.2, p.3])).chain(chart.y_line);
     let yr = range(ys, chart.log_y);
@@ -123,20 +126,19 @@ fn plot<DB, Y>(
     series: &[Series],
     xs: Range<f64>,
     y: Y,
-) -> Result<(), String>
+) -> DrawResult<DB>
 where
     DB: DrawingBackend,
     Y: AsRangedCoord<Value = f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
-    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let mut c = ChartBuilder::on(root)
         .caption(&chart.title, ("sans-serif", 24))
         .margin(15)
         .x_label_area_size(50)
         .y_label_area_size(90)
         .build_cartesian_2d(xs.log_scale(), y)
-        .map_err(err)?;
+        ?;
     c.configure_mesh()
         .x_desc(&chart.x_label)
         .y_desc(&chart.y_label)
@@ -147,7 +149,7 @@ where
         .x_label_formatter(&|v| short(*v))
         .y_label_formatter(&|v| short(*v))
         .draw()
-        .map_err(err)?;
+        ?;
     let ok = |v: f64| v.is_finite();
     for (i, s) in series.iter().enumerate() {
         let col = colour(i);
@@ -155,18 +157,18 @@ where
         if pts.iter().any(|p| p.1 != p.3) {
             let band: Vec<(f64, f64)> =
                 pts.iter().map(|p| (p.0, p.1)).chain(pts.iter().rev().map(|p| (p.0, p.3))).collect();
-            c.draw_series(std::iter::once(Polygon::new(band, col.mix(0.18).filled()))).map_err(err)?;
+            c.draw_series(std::iter::once(Polygon::new(band, col.mix(0.18).filled())))?;
         }
         let line: Vec<(f64, f64)> = s.points.iter().filter(|p| ok(p.0) && ok(p.2)).map(|p| (p.0, p.2)).collect();
         c.draw_series(LineSeries::new(line.clone(), col.stroke_width(2)))
-            .map_err(err)?
+            ?
             .label(s.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(3)));
-        c.draw_series(line.into_iter().map(|p| Circle::new(p, 3, col.filled()))).map_err(err)?;
+        c.draw_series(line.into_iter().map(|p| Circle::new(p, 3, col.filled())))?;
     }
     if let Some(v) = chart.y_line {
         let (x0, x1) = (c.x_range().start, c.x_range().end);
-        c.draw_series(std::iter::once(PathElement::new(vec![(x0, v), (x1, v)], BLACK.mix(0.5)))).map_err(err)?;
+        c.draw_series(std::iter::once(PathElement::new(vec![(x0, v), (x1, v)], BLACK.mix(0.5))))?;
     }
     c.configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -174,7 +176,7 @@ where
         .label_font(("sans-serif", 16))
         .position(if chart.legend_middle { SeriesLabelPosition::MiddleRight } else { SeriesLabelPosition::UpperRight })
         .draw()
-        .map_err(err)?;
+        ?;
     Ok(())
 }
 

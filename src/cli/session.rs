@@ -12,7 +12,7 @@
 //!   checks, so unfinished passes are abandoned after the tiles in flight;
 //!   then write both and exit 0. Further SIGINTs only set the flag again:
 //!   they cannot interrupt the saving. Every file is written atomically
-//!   ([`rust_v::atomic_file`]), so even `kill -9` mid-write leaves the old
+//!   ([`rust_v::io::atomic_file`]), so even `kill -9` mid-write leaves the old
 //!   or the new file, never a torn one.
 //!
 //! Signals that arrive faster than batches complete coalesce: one snapshot
@@ -31,7 +31,7 @@ use rust_v::film::Film;
 use rust_v::render::{Limits, render};
 use rust_v::scene::Scene;
 
-use crate::cli::{ProgressBar, report, thread_pool};
+use super::console::{ProgressBar, report, thread_pool};
 
 /// Where a session writes and how it runs.
 pub struct SessionPlan {

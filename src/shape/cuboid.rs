@@ -1,7 +1,7 @@
 //! Cuboids: axis-aligned boxes as solids (normals point outward). A ray starting
 //! inside hits the far face, still with the outward normal.
 
-use super::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use glam::Vec3;
 
 /// A solid axis-aligned box `[min, max]`.
@@ -89,7 +89,7 @@ impl Cuboid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::sphere::tests::random_dir;
+    use crate::shape::sphere::tests::random_dir;
     use rand_pcg::Pcg32;
 
     #[test]

@@ -1,0 +1,233 @@
+//! Every subcommand and flag of the command line (clap derive): the only
+//! place that knows clap. Settings flags become a [`SettingsPatch`], the
+//! same type as the scene file's `render` block.
+
+use std::ops::Range;
+use std::path::PathBuf;
+
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use clap::{Args, Parser, Subcommand};
+
+use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
+
+/// rust-v: a physically based spectral path tracer.
+#[derive(Debug, Parser)]
+#[command(name = "rust-v", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render a RON scene file to a 16-bit sRGB PNG (or a linear EXR).
+    ///
+    /// While it runs: SIGUSR1 writes a PNG snapshot (NAME-00128.png), SIGUSR2
+    /// a checkpoint, SIGINT/SIGTERM both and then exit 0.
+    Render(RenderArgs),
+    /// Continue a render from a checkpoint and write its image.
+    Resume(ResumeArgs),
+    /// Sum checkpoints of disjoint pass ranges of one scene into an image or a checkpoint.
+    Merge(MergeArgs),
+    /// Compare two images (PNG 8/16-bit or EXR): thesis MSE, PSNR, SSIM, windowed SSIM, linear errors.
+    Compare(CompareArgs),
+    /// Convergence study: render progressively with several methods and seeds, measure
+    /// against a reference at checkpoints, write CSVs and charts.
+    Converge(ConvergeArgs),
+}
+
+/// Flags of `compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The image to measure (PNG or EXR).
+    pub a: PathBuf,
+    /// The reference image (PNG or EXR); relative errors are relative to it.
+    pub b: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Flags of `converge`.
+#[derive(Debug, Args)]
+pub struct ConvergeArgs {
+    /// The scene file (RON).
+    pub scene: PathBuf,
+    /// The reference image (EXR from `rust-v render SCENE -o ref.exr --spp N`, or PNG).
+    /// The render size defaults to the reference's.
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Methods, comma-separated: auto, path, hero, random, whitted, rgb.
+    #[arg(long, value_delimiter = ',', default_value = "path,hero,random")]
+    pub methods: Vec<String>,
+    /// Render each method with this many seeds (the scene's seed, +1, +2, ...) to show the spread.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub seeds: u32,
+    /// Render each method (and seed) for this many seconds, measuring at 1, 2, 4, 8, ... spp.
+    #[arg(long, value_parser = parse_seconds, conflicts_with = "spp_schedule")]
+    pub time: Option<f64>,
+    /// Measure at these sample counts, comma-separated (default: 1, 2, 4, ... up to --spp).
+    #[arg(long, value_delimiter = ',')]
+    pub spp_schedule: Option<Vec<u32>>,
+    /// Directory for the CSVs and charts (default: the current directory).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress lines on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Flags of `render`. Settings given here override the scene file's `render` block.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The scene file (RON).
+    pub scene: PathBuf,
+    /// Output image: `.png` (16-bit sRGB) or `.exr` (linear sRGB, float). Default: the scene's name with `.png`, in the current directory.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub settings: SettingsArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress bar or summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Render only passes A to B-1 (`A..B`), e.g. one job's share of a distributed render.
+    #[arg(long, value_name = "A..B", value_parser = parse_pass_range)]
+    pub passes: Option<Range<u32>>,
+    #[command(flatten)]
+    pub checkpoint: CheckpointArgs,
+    /// Stop after this many seconds of rendering, in whole passes (no new pass starts
+    /// after it). Without --spp the render runs until the time is up.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub time: Option<f64>,
+}
+
+/// Checkpoint flags shared by `render` and `resume`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct CheckpointArgs {
+    /// Checkpoint file (default: the output's name with `.ckpt`). When given, the
+    /// checkpoint is also written when the render finishes.
+    #[arg(long, value_name = "PATH")]
+    pub checkpoint: Option<PathBuf>,
+    /// Write a checkpoint every SECONDS (between batches of passes).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub checkpoint_every: Option<f64>,
+}
+
+/// Flags of `resume`.
+#[derive(Debug, Args)]
+pub struct ResumeArgs {
+    /// The checkpoint to continue.
+    pub checkpoint_file: PathBuf,
+    /// Total samples per pixel to reach (default: the original target).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
+    /// Output image, `.png` or `.exr` (default: the original render's output).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// No progress bar or summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Checkpoint file (default: the checkpoint resumed). When given, the
+    /// checkpoint is also written when the render finishes.
+    #[arg(long, value_name = "PATH")]
+    pub checkpoint: Option<PathBuf>,
+    /// Write a checkpoint every SECONDS (between batches of passes).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub checkpoint_every: Option<f64>,
+    /// Resume even if the scene file changed since the checkpoint was written (the
+    /// image then mixes passes of two scenes; the new checkpoint records the new scene).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Flags of `merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Checkpoints of disjoint pass ranges of the same scene and settings.
+    #[arg(required = true, value_name = "PART.ckpt")]
+    pub parts: Vec<PathBuf>,
+    /// Output: `.png` or `.exr` writes the image, `.ckpt` a merged checkpoint.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// No summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `A..B` with A < B.
+fn parse_pass_range(s: &str) -> std::result::Result<Range<u32>, String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B (e.g. 0..64), got {s:?}"))?;
+    let a: u32 = a.trim().parse().map_err(|e| format!("start {a:?}: {e}"))?;
+    let b: u32 = b.trim().parse().map_err(|e| format!("end {b:?}: {e}"))?;
+    if a >= b {
+        return Err(format!("{a}..{b} is empty: the end must be greater than the start"));
+    }
+    Ok(a..b)
+}
+
+/// A positive, finite number of seconds.
+fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("expected a positive number of seconds, got {s:?}")),
+    }
+}
+
+/// Render settings shared by the subcommands that render.
+#[derive(Debug, Args, Clone, Default)]
+pub struct SettingsArgs {
+    /// Samples per pixel (one pass adds one sample to every pixel).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
+    /// Seed of the deterministic sampler.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Image width in pixels.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
+    pub height: Option<u32>,
+    /// Maximum scattering events per path (pbrt's maxdepth; Mitsuba's max_depth minus 1).
+    #[arg(long)]
+    pub max_bounces: Option<u32>,
+    /// Light transport method.
+    #[arg(long, value_parser = PossibleValuesParser::new(IntegratorKind::NAMES).map(|s| IntegratorKind::from_name(&s).unwrap_or(IntegratorKind::Auto)))]
+    pub integrator: Option<IntegratorKind>,
+    /// Wavelength sampling of the spectral integrator.
+    #[arg(long, value_parser = PossibleValuesParser::new(WavelengthsKind::NAMES).map(|s| WavelengthsKind::from_name(&s).unwrap_or(WavelengthsKind::Hero)))]
+    pub wavelengths: Option<WavelengthsKind>,
+    /// Wavelengths per packet of the spectral integrator, and the wavelengths `auto` draws where a path refracts into dispersive glass (1, 2, 4 or 8).
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4", "8"]).map(|s| s.parse::<u32>().unwrap_or(4)))]
+    pub packet_size: Option<u32>,
+}
+
+impl SettingsArgs {
+    /// The overrides in the scene format's terms.
+    pub fn overrides(&self) -> SettingsPatch {
+        SettingsPatch {
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            seed: self.seed,
+            max_bounces: self.max_bounces,
+            integrator: self.integrator,
+            wavelengths: self.wavelengths,
+            packet_size: self.packet_size,
+        }
+    }
+}
+

@@ -1,0 +1,175 @@
+//! `render`, `resume` and `merge`: from a scene file (or checkpoints) to an
+//! image. A render's passes run in a [`Session`] (signals, snapshots,
+//! checkpoints); `merge` sums checkpoints of disjoint pass ranges.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
+use rust_v::error::{Error, Result};
+use rust_v::film::Film;
+use rust_v::scene::load_scene;
+
+use super::args::{MergeArgs, RenderArgs, ResumeArgs};
+use super::session::{Session, SessionPlan};
+
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "render".into());
+    PathBuf::from(format!("{stem}.png"))
+}
+
+pub fn render_command(args: RenderArgs) -> Result<()> {
+    // Signals first: from here on SIGUSR1/2 no longer kill the process, and
+    // the first line on stderr tells a script that it may send them.
+    let session = Session::start()?;
+    let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
+    check_output_extension(&output)?;
+    let load_start = Instant::now();
+    let scene = load_scene(&args.scene, &args.settings.overrides())?;
+    let load_time = load_start.elapsed();
+    let s = &scene.settings;
+    if !args.quiet {
+        eprintln!(
+            "rust-v: {} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}\nrust-v: {}",
+            args.scene.display(),
+            scene.object_count(),
+            scene.lights.len(),
+            load_time.as_secs_f64(),
+            s.width,
+            s.height,
+            s.spp,
+            s.max_bounces,
+            s.seed,
+            rust_v::integrator::describe(&scene)
+        );
+    }
+    // With a time budget and no --spp (or --passes), render until the time is up.
+    let open_ended = args.time.is_some() && args.settings.spp.is_none() && args.passes.is_none();
+    let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
+    let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
+    let checkpoint = Checkpoint {
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+        scene_path,
+        content_hash: scene.content_hash,
+        settings: scene.settings.clone(),
+        target_end: passes.end,
+        output: std::path::absolute(&output).map_err(|e| Error::io(&output, e))?,
+        film: Film::starting_at(s.width, s.height, passes.start),
+    };
+    let plan = SessionPlan {
+        checkpoint_path: args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output)),
+        final_checkpoint: args.checkpoint.checkpoint.is_some(),
+        every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
+        output,
+        threads: args.threads,
+        quiet: args.quiet,
+        budget: args.time.map(Duration::from_secs_f64),
+    };
+    session.run(&scene, checkpoint, passes.end, &plan)
+}
+
+pub fn resume_command(args: ResumeArgs) -> Result<()> {
+    let session = Session::start()?;
+    let mut ckpt = Checkpoint::read(&args.checkpoint_file)?;
+    let path = &args.checkpoint_file;
+    if ckpt.crate_version != env!("CARGO_PKG_VERSION") && !args.quiet {
+        eprintln!(
+            "rust-v: warning: {} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
+            path.display(),
+            ckpt.crate_version,
+            env!("CARGO_PKG_VERSION")
+        );
+    }
+    let done = ckpt.passes();
+    let end = match args.spp {
+        Some(n) => done.start.checked_add(n).ok_or_else(|| Error::Settings(format!("--spp {n} is too large")))?,
+        None => ckpt.target_end,
+    };
+    if args.spp.is_some() {
+        ckpt.settings.spp = end - done.start;
+    }
+    let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
+    check_output_extension(&output)?;
+    let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
+        .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
+    if scene.content_hash != ckpt.content_hash && args.force {
+        eprintln!(
+            "rust-v: warning: {} changed since the checkpoint was written; resuming anyway (--force)",
+            ckpt.scene_path.display()
+        );
+        ckpt.content_hash = scene.content_hash;
+    }
+    if scene.content_hash != ckpt.content_hash {
+        return Err(Error::checkpoint(
+            path,
+            format!(
+                "the scene file {} changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same scene (or --force)",
+                ckpt.scene_path.display(),
+                scene.content_hash,
+                ckpt.content_hash
+            ),
+        ));
+    }
+    if scene.settings != ckpt.settings {
+        return Err(Error::checkpoint(path, format!("its settings {:?} load as {:?}", ckpt.settings, scene.settings)));
+    }
+    if !args.quiet {
+        eprintln!(
+            "rust-v: resuming {} ({}): passes {}..{} done, rendering to pass {}",
+            path.display(),
+            ckpt.scene_path.display(),
+            done.start,
+            done.end,
+            end.max(done.end)
+        );
+    }
+    ckpt.target_end = end.max(done.end);
+    ckpt.output = std::path::absolute(&output).map_err(|e| Error::io(&output, e))?;
+    let plan = SessionPlan {
+        checkpoint_path: args.checkpoint.clone().unwrap_or_else(|| path.clone()),
+        final_checkpoint: args.checkpoint.is_some(),
+        every: args.checkpoint_every.map(Duration::from_secs_f64),
+        output,
+        threads: args.threads,
+        quiet: args.quiet,
+        budget: None,
+    };
+    session.run(&scene, ckpt, end, &plan)
+}
+
+pub fn merge_command(args: MergeArgs) -> Result<()> {
+    let is_ckpt = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("ckpt"));
+    if !is_ckpt {
+        check_output_extension(&args.output)
+            .map_err(|_| Error::Settings(format!("output {}: expected .png, .exr or .ckpt", args.output.display())))?;
+    }
+    let mut parts = Vec::with_capacity(args.parts.len());
+    for p in &args.parts {
+        parts.push((p.clone(), Checkpoint::read(p)?));
+    }
+    let merged = merge(parts)?;
+    if is_ckpt {
+        merged.write(&args.output)?;
+    } else {
+        merged.film.write(&args.output)?;
+    }
+    if !args.quiet {
+        let r = merged.passes();
+        eprintln!(
+            "rust-v: merged {} checkpoints (passes {}..{}) into {}",
+            args.parts.len(),
+            r.start,
+            r.end,
+            args.output.display()
+        );
+    }
+    Ok(())
+}
+
+fn check_output_extension(output: &Path) -> Result<()> {
+    match output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()) {
+        Some(e) if e == "png" || e == "exr" => Ok(()),
+        _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", output.display()))),
+    }
+}
+

@@ -1,0 +1,101 @@
+//! Image files: writing a film's mean as a 16-bit sRGB PNG or a linear
+//! float EXR (atomically), and reading PNG or EXR images back for the
+//! analysis tools.
+//!
+//! - PNG: 16-bit sRGB. Each linear channel is clamped to [0, 1] (negative,
+//!   out-of-gamut values become 0; values above 1 become 1: no tone mapping,
+//!   no exposure) and encoded with the sRGB transfer curve ([`encode_u16`]).
+//! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
+//!   unclamped, for measurements.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use super::write_atomic;
+use crate::color::srgb_oetf;
+use crate::error::{Error, Result};
+
+/// True when `path` names an EXR file (by its extension, any case).
+pub fn is_exr(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// Writes `width` x `height` linear sRGB pixels (row-major): linear EXR if
+/// `path` ends in `.exr`, else 16-bit sRGB PNG. The file is encoded in
+/// memory, written under a temporary name, synced and renamed into place,
+/// so `path` never holds a partial image.
+pub fn write_linear_srgb(path: &Path, width: u32, height: u32, rgb: &[[f64; 3]]) -> Result<()> {
+    let mut bytes = Cursor::new(Vec::new());
+    let image_error = |e: image::ImageError| Error::Image { path: path.to_path_buf(), message: e.to_string() };
+    let size_error = || Error::Image { path: path.to_path_buf(), message: "buffer size does not match".into() };
+    if is_exr(path) {
+        let data: Vec<f32> = rgb.iter().flat_map(|p| p.map(|v| v as f32)).collect();
+        image::Rgb32FImage::from_raw(width, height, data)
+            .ok_or_else(size_error)?
+            .write_to(&mut bytes, image::ImageFormat::OpenExr)
+            .map_err(image_error)?;
+    } else {
+        let data: Vec<u16> = rgb.iter().flat_map(|p| p.map(encode_u16)).collect();
+        image::ImageBuffer::<image::Rgb<u16>, Vec<u16>>::from_raw(width, height, data)
+            .ok_or_else(size_error)?
+            .write_to(&mut bytes, image::ImageFormat::Png)
+            .map_err(image_error)?;
+    }
+    write_atomic(path, &bytes.into_inner())
+}
+
+/// The pixels of an image file as stored.
+#[derive(Debug)]
+pub enum Pixels {
+    /// Linear sRGB floats (EXR).
+    Linear(Vec<[f64; 3]>),
+    /// 16-bit sRGB codes (PNG of 8 or 16 bits per channel, widened).
+    Code16(Vec<[u16; 3]>),
+}
+
+/// Reads a PNG (8 or 16 bits per channel) or an EXR (linear sRGB floats):
+/// width, height and pixels.
+pub fn read_image(path: &Path) -> Result<(u32, u32, Pixels)> {
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| Error::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?;
+    let bad = |message: String| Error::Image { path: path.to_path_buf(), message };
+    let format = reader.format();
+    let img = reader.decode().map_err(|e| bad(format!("cannot decode: {e}")))?;
+    match format {
+        Some(image::ImageFormat::OpenExr) => {
+            let rgb = img.into_rgb32f();
+            let (w, h) = rgb.dimensions();
+            Ok((w, h, Pixels::Linear(rgb.pixels().map(|p| p.0.map(f64::from)).collect())))
+        }
+        Some(image::ImageFormat::Png) => {
+            let rgb = img.into_rgb16();
+            let (w, h) = rgb.dimensions();
+            Ok((w, h, Pixels::Code16(rgb.pixels().map(|p| p.0).collect())))
+        }
+        other => Err(bad(format!("expected a PNG or EXR image, found {other:?}"))),
+    }
+}
+
+/// Linear value to a 16-bit sRGB code: clamp to [0, 1], transfer curve, round.
+#[inline]
+pub fn encode_u16(linear: f64) -> u16 {
+    let v = if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) as f32 };
+    (srgb_oetf(v) * 65535.0 + 0.5) as u16
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encoding_clamps_and_follows_the_transfer_curve() {
+        assert_eq!(encode_u16(-0.5), 0);
+        assert_eq!(encode_u16(f64::NAN), 0);
+        assert_eq!(encode_u16(2.0), 65535);
+        assert_eq!(encode_u16(1.0), 65535);
+        // 0.5 linear is 0.7354 encoded (IEC 61966-2-1).
+        assert!((encode_u16(0.5) as f64 / 65535.0 - 0.73536).abs() < 1e-4);
+    }
+}

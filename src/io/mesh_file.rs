@@ -1,0 +1,93 @@
+//! Mesh files: OBJ (through tobj, triangulated) and PLY (ASCII or binary,
+//! [`super::ply`]), either optionally gzip-compressed (`.obj.gz`, `.ply.gz`),
+//! read into positions, triangles and optional normals in file order.
+//! Placing and intersecting a mesh is [`crate::shape::Mesh`]'s work.
+
+use std::io::Read;
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::ply;
+use crate::error::{Error, Result};
+
+/// Reads and decompresses a mesh file into positions, triangles and optional normals.
+pub fn read_mesh_file(path: &Path) -> Result<MeshData> {
+    let raw = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
+    let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
+        let mut out = Vec::with_capacity(raw.len() * 4);
+        flate2::read::MultiGzDecoder::new(raw.as_slice())
+            .read_to_end(&mut out)
+            .map_err(|e| Error::mesh(path, format!("gzip decompression failed: {e}")))?;
+        (out, stem.to_string())
+    } else {
+        (raw, name)
+    };
+    if name.ends_with(".ply") {
+        let d = ply::parse(&data, path)?;
+        Ok(MeshData { positions: d.positions, triangles: d.triangles, normals: d.normals })
+    } else if name.ends_with(".obj") {
+        load_obj(&data, path)
+    } else {
+        Err(Error::mesh(path, "unknown mesh format: expected a name ending in .obj, .ply, .obj.gz or .ply.gz"))
+    }
+}
+
+/// A mesh file's contents in file order, before any transform or filtering.
+#[derive(Debug)]
+pub struct MeshData {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Triangles as vertex indices (polygons fan-triangulated).
+    pub triangles: Vec<[u32; 3]>,
+    /// Per-vertex normals, when the file has one for every vertex.
+    pub normals: Option<Vec<Vec3>>,
+}
+
+/// Reads an OBJ file (all its objects and groups merged) with tobj, triangulated, with
+/// one index per vertex so that normals line up with positions.
+fn load_obj(data: &[u8], path: &Path) -> Result<MeshData> {
+    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let mut reader = std::io::BufReader::new(data);
+    // tobj multiplies face indices without overflow checks: a huge index (e.g. a
+    // relative -2147483649) panics in builds with overflow checks. Turn that into an error.
+    let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut reader, &opts, |_| Ok((Vec::new(), Default::default())))
+    }))
+    .map_err(|_| Error::mesh(path, "OBJ parse error: index out of range (the OBJ parser panicked)"))?;
+    let (models, _materials) = parsed.map_err(|e| Error::mesh(path, format!("OBJ parse error: {e}")))?;
+    let mut positions = Vec::new();
+    let mut indices = Vec::new();
+    let mut normals = Vec::new();
+    let mut all_normals = true;
+    for model in &models {
+        let m = &model.mesh;
+        let base = positions.len() as u32;
+        let nv = m.positions.len() / 3;
+        positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        if m.normals.len() == m.positions.len() {
+            normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        } else {
+            all_normals = false;
+        }
+        if m.indices.len() % 3 != 0 {
+            return Err(Error::mesh(
+                path,
+                format!("object '{}': {} indices is not a multiple of 3", model.name, m.indices.len()),
+            ));
+        }
+        for c in m.indices.chunks_exact(3) {
+            if let Some(&bad) = c.iter().find(|&&i| i as usize >= nv) {
+                return Err(Error::mesh(
+                    path,
+                    format!("object '{}': vertex index {} out of range ({nv} vertices)", model.name, bad + 1),
+                ));
+            }
+            indices.push([base + c[0], base + c[1], base + c[2]]);
+        }
+    }
+    let normals = (all_normals && !normals.is_empty()).then_some(normals);
+    Ok(MeshData { positions, triangles: indices, normals })
+}
+

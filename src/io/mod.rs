@@ -1,0 +1,15 @@
+//! Files in and out: atomic writes, mesh files (OBJ, PLY, optionally
+//! gzip-compressed), image files, and the crate's one hash.
+//!
+//! Everything here turns bytes on disk into the renderer's types or back,
+//! and reports failures as [`crate::Error`]s that name the file (and the
+//! line, where the format has lines). Nothing here renders.
+
+pub mod atomic_file;
+pub mod hash;
+pub mod image;
+pub mod mesh_file;
+mod ply;
+
+pub use atomic_file::{temp_path, write_atomic};
+pub use hash::{Fnv1a, fnv1a};

@@ -1,0 +1,311 @@
+//! Render settings: the one definition that the scene file's `render` block,
+//! the command-line overrides and the checkpoint header all use.
+//!
+//! Every setting is listed once, in the [`settings!`] invocation below, with
+//! its type, default and doc. From that list come:
+//! - [`Settings`], the complete settings of a render (what a checkpoint
+//!   stores, what the integrators read);
+//! - [`SettingsPatch`], every field optional: the scene file's `render` block
+//!   (serde, unknown fields refused) and the command line's overrides;
+//! - [`Settings::apply`], [`Settings::patch`] and [`Settings::differences`].
+//!
+//! Precedence: defaults, then the file's block, then the command line
+//! (`Settings::default().apply(&file).apply(&cli)`).
+//!
+//! ```ron
+//! render: (width: 512, height: 512, spp: 256, seed: 0, max_bounces: 8,
+//!          integrator: auto, wavelengths: hero, packet_size: 4),
+//! ```
+//!
+//! In a checkpoint the settings are encoded field by field in this order
+//! (bincode), with the two enums as their lowercase names, exactly as
+//! format version 1 has always stored them.
+
+use serde::{Deserialize, Serialize};
+
+/// Declares a closed set of named choices: the RON identifiers and
+/// command-line values are the lowercase names.
+macro_rules! named_enum {
+    ($(#[$meta:meta])* $name:ident { $($(#[$vmeta:meta])* $variant:ident = $text:literal,)+ }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+        #[serde(rename_all = "lowercase")]
+        pub enum $name {
+            $($(#[$vmeta])* $variant,)+
+        }
+
+        impl $name {
+            /// Every value, in declaration order.
+            pub const ALL: &'static [$name] = &[$($name::$variant,)+];
+            /// Every name, in declaration order.
+            pub const NAMES: &'static [&'static str] = &[$($text,)+];
+
+            /// The name in scene files, on the command line and in checkpoints.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $($name::$variant => $text,)+
+                }
+            }
+
+            /// The value of a name, if it is one.
+            pub fn from_name(s: &str) -> Option<Self> {
+                match s {
+                    $($text => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+
+named_enum! {
+    /// The light-transport methods ([`crate::integrator`]).
+    IntegratorKind {
+        /// The default: full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
+        Auto = "auto",
+        /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
+        Path = "path",
+        /// Whitted-style recursive ray tracing: E S* (D|G) L.
+        Whitted = "whitted",
+        /// Spectral path tracing with wavelength packets that split at dispersive surfaces.
+        Spectral = "spectral",
+    }
+}
+
+named_enum! {
+    /// Wavelength sampling of the `spectral` integrator ([`crate::spectral`]).
+    WavelengthsKind {
+        /// One uniform hero bin, the others at equal rotation.
+        Hero = "hero",
+        /// Independent uniform bins.
+        Random = "random",
+        /// Three fixed wavelengths (435.8, 546.1, 700 nm) read out as RGB.
+        Rgb = "rgb",
+    }
+}
+
+/// Encodes a named enum as its name (binary formats: the checkpoint header).
+mod by_name {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error as _};
+
+    pub trait Named: Sized + Copy {
+        fn name(self) -> &'static str;
+        fn from_name(s: &str) -> Option<Self>;
+        const WHAT: &'static str;
+    }
+
+    impl Named for super::IntegratorKind {
+        fn name(self) -> &'static str {
+            super::IntegratorKind::name(self)
+        }
+        fn from_name(s: &str) -> Option<Self> {
+            super::IntegratorKind::from_name(s)
+        }
+        const WHAT: &'static str = "integrator";
+    }
+
+    impl Named for super::WavelengthsKind {
+        fn name(self) -> &'static str {
+            super::WavelengthsKind::name(self)
+        }
+        fn from_name(s: &str) -> Option<Self> {
+            super::WavelengthsKind::from_name(s)
+        }
+        const WHAT: &'static str = "wavelength sampling";
+    }
+
+    pub fn serialize<T: Named, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(v.name())
+    }
+
+    pub fn deserialize<'de, T: Named, D: Deserializer<'de>>(d: D) -> Result<T, D::Error> {
+        let s = String::deserialize(d)?;
+        T::from_name(&s).ok_or_else(|| D::Error::custom(format!("unknown {} {s:?}", T::WHAT)))
+    }
+}
+
+/// Declares every setting once: name, type, default, doc, and how the
+/// checkpoint encodes it.
+macro_rules! settings {
+    ($($(#[doc = $doc:literal])+ $field:ident: $ty:ty = $default:expr $(, serde($($serde:tt)*))?;)+) => {
+        /// The complete settings of a render (defaults, the scene file's
+        /// `render` block and the command line, combined).
+        #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+        pub struct Settings {
+            $($(#[doc = $doc])+ $(#[serde($($serde)*)])? pub $field: $ty,)+
+        }
+
+        /// Settings where each field may be absent: the scene file's `render`
+        /// block and the command line's overrides.
+        #[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct SettingsPatch {
+            $($(#[doc = $doc])+ pub $field: Option<$ty>,)+
+        }
+
+        impl Default for Settings {
+            fn default() -> Self {
+                Settings { $($field: $default,)+ }
+            }
+        }
+
+        impl Settings {
+            /// These settings with every field that `patch` gives replaced.
+            pub fn apply(mut self, patch: &SettingsPatch) -> Settings {
+                $(if let Some(v) = patch.$field.clone() {
+                    self.$field = v;
+                })+
+                self
+            }
+
+            /// Every field as a patch (to load a scene exactly as it was rendered).
+            pub fn patch(&self) -> SettingsPatch {
+                SettingsPatch { $($field: Some(self.$field.clone()),)+ }
+            }
+
+            /// `(field, value)` for every field, values as in a scene file.
+            pub fn fields(&self) -> Vec<(&'static str, String)> {
+                vec![$((stringify!($field), Value::text(&self.$field)),)+]
+            }
+        }
+    };
+}
+
+settings! {
+    /// Image width in pixels (default 512).
+    width: u32 = 512;
+    /// Image height in pixels (default 512).
+    height: u32 = 512;
+    /// Samples per pixel = passes (default 64).
+    spp: u32 = 64;
+    /// Seed of the deterministic sampler (default 0).
+    seed: u64 = 0;
+    /// Maximum number of scattering events on a path (default 8; see [`crate::integrator`]).
+    max_bounces: u32 = 8;
+    /// Integrator: `auto`, `path`, `whitted` or `spectral` (default `auto`).
+    integrator: IntegratorKind = IntegratorKind::Auto, serde(with = "by_name");
+    /// Wavelength sampling of the `spectral` integrator: `hero`, `random` or `rgb` (default `hero`).
+    wavelengths: WavelengthsKind = WavelengthsKind::Hero, serde(with = "by_name");
+    /// Wavelengths per packet of the `spectral` integrator, and the wavelengths
+    /// `auto` draws where a path refracts into dispersive glass: 1, 2, 4 or 8 (default 4).
+    packet_size: u32 = 4;
+}
+
+/// A setting's value as text.
+trait Value {
+    fn text(&self) -> String;
+}
+
+impl Value for u32 {
+    fn text(&self) -> String {
+        self.to_string()
+    }
+}
+
+impl Value for u64 {
+    fn text(&self) -> String {
+        self.to_string()
+    }
+}
+
+impl Value for IntegratorKind {
+    fn text(&self) -> String {
+        self.name().into()
+    }
+}
+
+impl Value for WavelengthsKind {
+    fn text(&self) -> String {
+        self.name().into()
+    }
+}
+
+/// The largest image side, in pixels.
+pub const MAX_SIDE: u32 = 1 << 15;
+
+/// The packet sizes the integrators are compiled for.
+pub const PACKET_SIZES: [u32; 4] = [1, 2, 4, 8];
+
+impl Settings {
+    /// Defaults, then `file` (the scene's `render` block), then `cli`.
+    pub fn combine(file: &SettingsPatch, cli: &SettingsPatch) -> Settings {
+        Settings::default().apply(file).apply(cli)
+    }
+
+    /// The first setting out of range, as `(field, what was expected)`.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        for (name, v) in [("width", self.width), ("height", self.height), ("spp", self.spp)] {
+            if v == 0 {
+                return Err((name, "expected a positive number, found 0".into()));
+            }
+        }
+        if self.width > MAX_SIDE || self.height > MAX_SIDE {
+            let name = if self.width > MAX_SIDE { "width" } else { "height" };
+            return Err((name, format!("expected at most {MAX_SIDE} pixels per side")));
+        }
+        if !PACKET_SIZES.contains(&self.packet_size) {
+            return Err(("packet_size", format!("expected 1, 2, 4 or 8, found {}", self.packet_size)));
+        }
+        Ok(())
+    }
+
+    /// The settings that differ from `other`'s, as `name other vs self`,
+    /// ignoring `spp` (a target, which changes no sample).
+    pub fn differences(&self, other: &Settings) -> Vec<String> {
+        self.fields()
+            .into_iter()
+            .zip(other.fields())
+            .filter(|((name, a), (_, b))| *name != "spp" && a != b)
+            .map(|((name, a), (_, b))| format!("{name} {b} vs {a}"))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patches_apply_in_order_and_round_trip() {
+        let file = SettingsPatch { width: Some(64), integrator: Some(IntegratorKind::Path), ..Default::default() };
+        let cli = SettingsPatch { width: Some(32), seed: Some(9), ..Default::default() };
+        let s = Settings::combine(&file, &cli);
+        assert_eq!((s.width, s.height, s.seed, s.integrator), (32, 512, 9, IntegratorKind::Path));
+        assert_eq!(Settings::default().apply(&s.patch()), s);
+    }
+
+    #[test]
+    fn names_round_trip() {
+        for k in IntegratorKind::ALL {
+            assert_eq!(IntegratorKind::from_name(k.name()), Some(*k));
+        }
+        for k in WavelengthsKind::ALL {
+            assert_eq!(WavelengthsKind::from_name(k.name()), Some(*k));
+        }
+        assert_eq!(IntegratorKind::from_name("bdpt"), None);
+    }
+
+    #[test]
+    fn checks_and_differences() {
+        let s = Settings::default();
+        assert!(s.check().is_ok());
+        assert_eq!(Settings { width: 0, ..s.clone() }.check().unwrap_err().0, "width");
+        assert_eq!(Settings { height: MAX_SIDE + 1, ..s.clone() }.check().unwrap_err().0, "height");
+        assert_eq!(Settings { packet_size: 3, ..s.clone() }.check().unwrap_err().0, "packet_size");
+        let t = Settings { spp: 5, seed: 2, wavelengths: WavelengthsKind::Rgb, ..s.clone() };
+        assert_eq!(s.differences(&t), vec!["seed 2 vs 0".to_string(), "wavelengths rgb vs hero".to_string()]);
+    }
+
+    /// The header layout of checkpoint format 1: the fields in order, the
+    /// enums as strings (bincode's standard configuration).
+    #[test]
+    fn binary_encoding_is_format_1() {
+        let s = Settings { integrator: IntegratorKind::Spectral, ..Settings::default() };
+        let config = bincode::config::standard();
+        let bytes = bincode::serde::encode_to_vec(&s, config).unwrap();
+        let old = (512u32, 512u32, 64u32, 0u64, 8u32, "spectral", "hero", 4u32);
+        assert_eq!(bytes, bincode::serde::encode_to_vec(old, config).unwrap());
+        let (back, _): (Settings, usize) = bincode::serde::decode_from_slice(&bytes, config).unwrap();
+        assert_eq!(back, s);
+    }
+}
