@@ -33,11 +33,11 @@ pub mod integrator;
 pub mod io;
 pub mod light;
 pub mod render;
-pub mod sampler;
+pub(crate) mod sampler;
 pub mod scene;
 pub mod settings;
 pub mod shape;
-pub mod spectral;
+pub(crate) mod spectral;
 pub mod study;
 
 pub use error::{Error, Result};

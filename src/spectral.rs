@@ -105,7 +105,7 @@ impl<const N: usize> Lambdas<N> {
                 // The identity packet (the full spectrum): bin i is value i, no
                 // index conversion (this runs once per camera sample).
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
-                for (v, w) in l.0.iter().zip(&color::cie::CMF_NORMALISED) {
+                for (v, w) in l.0.iter().zip(&color::CMF_NORMALISED) {
                     x += v * w[0];
                     y += v * w[1];
                     z += v * w[2];
@@ -116,7 +116,7 @@ impl<const N: usize> Lambdas<N> {
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
                 for i in 0..N {
                     // Packets of sampled bins always sit on integer positions.
-                    let w = color::cie::CMF_NORMALISED[self.pos[i] as usize];
+                    let w = color::CMF_NORMALISED[self.pos[i] as usize];
                     x += l.0[i] * w[0];
                     y += l.0[i] * w[1];
                     z += l.0[i] * w[2];

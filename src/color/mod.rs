@@ -4,10 +4,10 @@
 //! CIE XYZ with the normalised colour matching functions in [`cie`], and to sRGB with the same
 //! matrix as Mitsuba 3 ([`rgb`]). [`named`] holds the spectra a scene file can refer to.
 
-pub mod cie;
-pub mod named;
-pub mod rgb;
-pub mod spectrum;
+mod cie;
+mod named;
+mod rgb;
+mod spectrum;
 
 pub use cie::{CMF, CMF_NORMALISED, bin_xyz};
 pub use named::{COLOR_CHECKER_NAMES, blackbody, color_checker, d65, equal_energy, planck, reflectance_to_xyz};

@@ -5,11 +5,12 @@
 //! and reports failures as [`crate::Error`]s that name the file (and the
 //! line, where the format has lines). Nothing here renders.
 
-pub mod atomic_file;
-pub mod hash;
+mod atomic_file;
+mod hash;
 pub mod image;
-pub mod mesh_file;
+mod mesh_file;
 mod ply;
 
 pub use atomic_file::{temp_path, write_atomic};
 pub use hash::{Fnv1a, fnv1a};
+pub use mesh_file::{MeshData, read_mesh_file};

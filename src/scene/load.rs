@@ -15,7 +15,7 @@ use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
-use crate::light::Light;
+use crate::light::{DiskLight, Light, PointLight, SphereLight};
 
 /// The largest coordinate or size a scene may give: squares and products of a few
 /// such numbers must stay finite in f32 (max 3.4e38), or intersections and light
@@ -95,18 +95,18 @@ impl Ctx<'_> {
                 }
                 Spectrum::from_fn(|i| v[i])
             }
-            SpectrumDesc::ColorChecker(name) => color::named::color_checker(name).ok_or_else(|| {
+            SpectrumDesc::ColorChecker(name) => color::color_checker(name).ok_or_else(|| {
                 self.err(
                     field,
                     format!(
                         "unknown ColorChecker patch \"{name}\"; expected one of: {}",
-                        color::named::COLOR_CHECKER_NAMES.join(", ")
+                        color::COLOR_CHECKER_NAMES.join(", ")
                     ),
                 )
             })?,
-            SpectrumDesc::D65 => color::named::d65(),
-            SpectrumDesc::EqualEnergy => color::named::equal_energy(),
-            SpectrumDesc::Blackbody(t) => color::named::blackbody(*t)
+            SpectrumDesc::D65 => color::d65(),
+            SpectrumDesc::EqualEnergy => color::equal_energy(),
+            SpectrumDesc::Blackbody(t) => color::blackbody(*t)
                 .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
             SpectrumDesc::Scaled(k, inner) => self.spectrum(field, inner)? * *k,
         };
@@ -267,8 +267,10 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
             Some(e) => {
                 let radiance = ctx.spectrum(&format!("{field}.emission"), e)?;
                 let l = match &shape {
-                    Shape::Sphere(s) => Light::Sphere { sphere: s.clone(), radiance, two_sided: o.two_sided },
-                    Shape::Disk(d) => Light::Disk { disk: d.clone(), radiance, two_sided: o.two_sided },
+                    Shape::Sphere(s) => {
+                        Light::Sphere(SphereLight { sphere: s.clone(), radiance, two_sided: o.two_sided })
+                    }
+                    Shape::Disk(d) => Light::Disk(DiskLight { disk: d.clone(), radiance, two_sided: o.two_sided }),
                     _ => return Err(ctx.err(format!("{field}.emission"), "only Sphere and Disk shapes can emit")),
                 };
                 lights.push(l);
@@ -279,10 +281,10 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
     }
     for (i, l) in desc.lights.iter().enumerate() {
         match l {
-            LightDesc::Point { position, intensity } => lights.push(Light::Point {
+            LightDesc::Point { position, intensity } => lights.push(Light::Point(PointLight {
                 position: ctx.vec(&format!("lights[{i}].position"), *position)?,
                 intensity: ctx.spectrum(&format!("lights[{i}].intensity"), intensity)?,
-            }),
+            })),
         }
     }
     if objects.is_empty() {

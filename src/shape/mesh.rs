@@ -11,7 +11,7 @@ use super::bvh::Bvh;
 use super::triangle::TriRay;
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Hit, Ray};
-use crate::io::mesh_file::{MeshData, read_mesh_file};
+use crate::io::{MeshData, read_mesh_file};
 
 /// Placement of a mesh: scale, then rotate about X, then Y, then Z (degrees), then
 /// translate. The default is the identity.

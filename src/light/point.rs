@@ -1,0 +1,39 @@
+//! An isotropic point light: intensity `I(λ)` from one point, a delta
+//! light (found only by light sampling; irradiance `I cos θ / d²`).
+//!
+//! ```ron
+//! lights: [ Point(position: (0, 1.9, 0), intensity: Scaled(2, D65)) ],
+//! ```
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::LightSample;
+use crate::color::Spectrum;
+
+/// An isotropic point light of intensity `intensity` (W/sr/nm, arbitrary units).
+#[derive(Clone, Debug)]
+pub struct PointLight {
+    /// Position.
+    pub position: Vec3,
+    /// Radiant intensity per wavelength.
+    pub intensity: Spectrum,
+}
+
+impl PointLight {
+    /// Total power up to the spectrum's shape: `4π` times the mean intensity.
+    pub fn power(&self) -> f32 {
+        4.0 * PI * self.intensity.average()
+    }
+
+    /// The direction to the light from `p`, with the `1/d²` falloff as `scale`.
+    #[inline]
+    pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
+        let d = self.position - p;
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        Some(LightSample { wi: d / d2.sqrt(), point: self.position, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
+    }
+}
