@@ -12,8 +12,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use rust_v::film::Film;
 use rust_v::render::{Limits, TILE_SIZE, render};
-use rust_v::settings::{IntegratorKind, SettingsPatch};
 use rust_v::scene::load_scene;
+use rust_v::settings::{IntegratorKind, SettingsPatch};
 
 /// Counts calls to `alloc` and `realloc` (and bytes asked for), then defers to the system allocator.
 struct Counting;

@@ -6,8 +6,8 @@
 use glam::Vec3;
 use rand::Rng;
 use rand_pcg::Pcg32;
-use rust_v::shape::Bvh;
 use rust_v::geometry::{Aabb, Ray};
+use rust_v::shape::Bvh;
 use rust_v::shape::{Mesh, Transform};
 use std::path::Path;
 use std::time::{Duration, Instant};

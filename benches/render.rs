@@ -17,8 +17,8 @@ use std::time::Instant;
 
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
-use rust_v::settings::{IntegratorKind, SettingsPatch};
 use rust_v::scene::load_scene;
+use rust_v::settings::{IntegratorKind, SettingsPatch};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);

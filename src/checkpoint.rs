@@ -32,10 +32,10 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::io::write_atomic;
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::io::Fnv1a;
+use crate::io::write_atomic;
 use crate::settings::Settings;
 
 /// The first 8 bytes of every checkpoint.

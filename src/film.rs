@@ -222,7 +222,7 @@ impl Film {
     /// Returns the invalid samples.
     pub fn add_tiles_parallel(&mut self, tiles: &[Tile], samples: &[Vec<Xyz>], tile_size: u32) -> usize {
         use rayon::prelude::*;
-        assert!(!tiles.is_empty() && samples.len() % tiles.len() == 0, "samples must hold whole passes");
+        assert!(!tiles.is_empty() && samples.len().is_multiple_of(tiles.len()), "samples must hold whole passes");
         let width = self.width;
         let tiles_x = width.div_ceil(tile_size).max(1) as usize;
         let band_len = width as usize * tile_size as usize;
@@ -259,9 +259,13 @@ impl Film {
             self.first_pass = other.first_pass;
         } else if other.passes > 0 && other.first_pass != self.pass_range().end {
             let (a, b) = (self.pass_range(), other.pass_range());
-            return Err(Error::Mismatch(format!("passes {}..{} do not follow passes {}..{}", b.start, b.end, a.start, a.end)));
+            return Err(Error::Mismatch(format!(
+                "passes {}..{} do not follow passes {}..{}",
+                b.start, b.end, a.start, a.end
+            )));
         }
-        let passes = self.passes.checked_add(other.passes).ok_or_else(|| Error::Mismatch("more than 2^32 passes".into()))?;
+        let passes =
+            self.passes.checked_add(other.passes).ok_or_else(|| Error::Mismatch("more than 2^32 passes".into()))?;
         for (s, o) in self.sums.iter_mut().zip(&other.sums) {
             for c in 0..3 {
                 s[c] = s[c].checked_add(o[c]).ok_or_else(|| Error::Mismatch("a pixel sum overflows".into()))?;

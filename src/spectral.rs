@@ -99,7 +99,7 @@ impl<const N: usize> Lambdas<N> {
     }
 
     /// The colour of a packet of radiance values.
-    pub fn to_xyz(&self, l: &Sampled<N>) -> Xyz {
+    pub fn xyz(&self, l: &Sampled<N>) -> Xyz {
         match self.readout {
             Readout::Spectral if N == N_BINS => {
                 // The identity packet (the full spectrum): bin i is value i, no
@@ -297,7 +297,7 @@ mod tests {
     fn full_packet_reads_out_the_spectrum_xyz() {
         let s = Spectrum::from_fn(|i| 0.1 + 0.02 * i as f32);
         let l = Lambdas::full();
-        let a = l.to_xyz(&l.sample(&s));
+        let a = l.xyz(&l.sample(&s));
         let b = s.to_xyz();
         assert!((a.x - b.x).abs() < 1e-5 && (a.y - b.y).abs() < 1e-5 && (a.z - b.z).abs() < 1e-5);
     }
@@ -311,7 +311,7 @@ mod tests {
         let mut sum = [0.0f64; 3];
         for h in 0..N_BINS {
             let l = sample_packet::<4>(WavelengthSampling::Hero, [(h as f32 + 0.5) / 36.0, 0.0, 0.0, 0.0]);
-            let xyz = l.to_xyz(&l.sample(&s));
+            let xyz = l.xyz(&l.sample(&s));
             sum[0] += xyz.x as f64;
             sum[1] += xyz.y as f64;
             sum[2] += xyz.z as f64;
@@ -327,15 +327,15 @@ mod tests {
         let l = Lambdas::rgb();
         assert!((l.lambda_nm(0) - 435.8).abs() < 1e-3 && (l.lambda_nm(2) - 700.0).abs() < 1e-3);
         // Values (b, g, r) = (0.25, 0.5, 1.0) read back as linear sRGB (1.0, 0.5, 0.25).
-        let xyz = l.to_xyz(&Sampled([0.25, 0.5, 1.0]));
+        let xyz = l.xyz(&Sampled([0.25, 0.5, 1.0]));
         let rgb = xyz.to_linear_srgb();
         assert!((rgb.r - 1.0).abs() < 1e-4 && (rgb.g - 0.5).abs() < 1e-4 && (rgb.b - 0.25).abs() < 1e-4);
         // Split into single wavelengths, the three read-outs add up to the same colour.
         let mut sum = Xyz::default();
         for (i, v) in [0.25, 0.5, 1.0].into_iter().enumerate() {
             let one = l.single(i);
-            let x = one.to_xyz(&Sampled([v]));
-            sum = sum + x;
+            let x = one.xyz(&Sampled([v]));
+            sum += x;
         }
         assert!((sum.x - xyz.x).abs() < 1e-4 && (sum.y - xyz.y).abs() < 1e-4 && (sum.z - xyz.z).abs() < 1e-4);
     }

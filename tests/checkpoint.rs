@@ -10,8 +10,8 @@ use std::sync::atomic::AtomicBool;
 use rust_v::checkpoint::{Checkpoint, merge};
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
-use rust_v::settings::SettingsPatch;
 use rust_v::scene::{Scene, load_scene};
+use rust_v::settings::SettingsPatch;
 
 use crate::common::{root, rust_v, temp_dir};
 

@@ -8,8 +8,8 @@ use std::sync::atomic::AtomicBool;
 
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
-use rust_v::settings::SettingsPatch;
 use rust_v::scene::load_scene_str;
+use rust_v::settings::SettingsPatch;
 
 /// The repository root.
 pub fn root() -> PathBuf {

@@ -20,10 +20,10 @@ use std::sync::atomic::AtomicBool;
 use rand::Rng;
 use rand_pcg::Pcg32;
 use rust_v::film::Film;
-use rust_v::shape::{Mesh, Transform};
 use rust_v::render::{Limits, render};
-use rust_v::settings::SettingsPatch;
 use rust_v::scene::load_scene_str;
+use rust_v::settings::SettingsPatch;
+use rust_v::shape::{Mesh, Transform};
 
 use crate::common::{root, temp_dir};
 
@@ -130,7 +130,7 @@ const TOKENS: &[&str] = &[
 
 /// Returns a random integer in `0..n` (`n > 0`).
 fn below(rng: &mut Pcg32, n: usize) -> usize {
-    (rng.next_u32() as u64 * n as u64 >> 32) as usize
+    ((rng.next_u32() as u64 * n as u64) >> 32) as usize
 }
 
 /// Applies one to four random mutations to `data`.

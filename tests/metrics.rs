@@ -2,7 +2,7 @@
 //! properties), and the `compare` and `converge` subcommands through the binary.
 
 use rust_v::study::metrics::{
-    CHANNEL_L, Image, K1, K2, THESIS_L, error_variance, measure, mse16, psnr16, ssim_global, ssim_windowed,
+    CHANNEL_L, Image, K1, THESIS_L, error_variance, measure, mse16, psnr16, ssim_global, ssim_windowed,
 };
 
 use crate::common::{root, rust_v, temp_dir};
@@ -22,7 +22,7 @@ fn noise(n: usize, seed: u64) -> Vec<f64> {
 
 #[test]
 fn l_constant_is_the_thesis_value() {
-    assert!((THESIS_L - 113_509.9497).abs() < 1e-4);
+    assert!((THESIS_L - 113_509.949_7).abs() < 1e-4);
 }
 
 #[test]
@@ -105,7 +105,6 @@ fn windowed_ssim_of_constant_images_has_a_closed_form() {
     let c1 = (K1 * CHANNEL_L).powi(2);
     let expected = (0..3).map(|c| (2.0 * x[c] * y[c] + c1) / (x[c] * x[c] + y[c] * y[c] + c1)).sum::<f64>() / 3.0;
     assert!((ssim_windowed(&a, &b, w, h) - expected).abs() < 1e-9);
-    assert!(K2 > K1);
 }
 
 #[test]

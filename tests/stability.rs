@@ -611,11 +611,7 @@ fn degenerate_triangles_and_meshes_with_holes() {
     let path = open_cube_obj();
     let mesh = rust_v::shape::Mesh::load(
         &path,
-        &rust_v::shape::Transform {
-            scale: glam::Vec3::ONE,
-            rotate_deg: glam::Vec3::ZERO,
-            translate: glam::Vec3::ZERO,
-        },
+        &rust_v::shape::Transform { scale: glam::Vec3::ONE, rotate_deg: glam::Vec3::ZERO, translate: glam::Vec3::ZERO },
     )
     .expect("loads");
     assert_eq!((mesh.triangle_count(), mesh.degenerate_dropped()), (10, 3));

@@ -21,8 +21,8 @@
 use glam::Vec3;
 
 use super::{BsdfSample, Ior, fresnel_dielectric, refract};
-use crate::color::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, bin_lambda_nm};
 use crate::color::Sampled;
+use crate::color::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, bin_lambda_nm};
 use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM};
 
 /// A smooth dielectric; the outside (the side the normal points to) is the

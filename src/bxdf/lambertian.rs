@@ -9,9 +9,9 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
 use super::BsdfSample;
+use crate::color::Sampled;
 use crate::color::Spectrum;
 use crate::sampler::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
-use crate::color::Sampled;
 use crate::spectral::Lambdas;
 
 /// Lambertian reflection with a spectral reflectance.

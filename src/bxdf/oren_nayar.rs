@@ -12,8 +12,8 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
 use super::{BsdfSample, lambertian};
-use crate::color::Spectrum;
 use crate::color::Sampled;
+use crate::color::Spectrum;
 use crate::spectral::Lambdas;
 
 /// Oren-Nayar reflection.

@@ -99,7 +99,7 @@ fn chi2_p_value(chi2: f64, dof: usize) -> f64 {
 fn incomplete_gamma_matches_closed_forms() {
     // Q(1, x) = e^-x; Q(1/2, x) = erfc(√x); Q(n, x) = e^-x Σ_{k<n} x^k / k!.
     for x in [0.01, 0.5, 1.0, 2.0, 7.5, 30.0] {
-        assert!((gamma_q(1.0, x) - (-x as f64).exp()).abs() < 1e-12, "Q(1, {x})");
+        assert!((gamma_q(1.0, x) - (-x).exp()).abs() < 1e-12, "Q(1, {x})");
         let poisson: f64 = (0..5).map(|k| x.powi(k) / (1..=k).product::<i32>().max(1) as f64).sum::<f64>() * (-x).exp();
         assert!((gamma_q(5.0, x) - poisson).abs() < 1e-12, "Q(5, {x})");
     }

@@ -19,7 +19,6 @@ pub fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
     b.build().map_err(|e| Error::Settings(format!("cannot start {threads:?} threads: {e}")))
 }
 
-
 /// Prints the warnings and the summary of a finished render.
 pub fn report(scene: &Scene, stats: &RenderStats, output: &Path, quiet: bool) {
     if stats.invalid_samples > 0 {

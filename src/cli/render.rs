@@ -172,4 +172,3 @@ fn check_output_extension(output: &Path) -> Result<()> {
         _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", output.display()))),
     }
 }
-

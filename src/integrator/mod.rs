@@ -28,13 +28,13 @@ pub use whitted::Whitted;
 use glam::{Vec2, Vec3};
 
 use crate::bxdf::Bxdf;
+use crate::color::Sampled;
 use crate::color::Xyz;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
-use crate::settings::{IntegratorKind, Settings, WavelengthsKind};
 use crate::scene::Scene;
-use crate::color::Sampled;
+use crate::settings::{IntegratorKind, Settings, WavelengthsKind};
 use crate::spectral::{Lambdas, WavelengthSampling, sample_packet};
 
 /// Computes the colour of one camera sample. Implementations are chosen once

@@ -25,9 +25,7 @@ use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
-use crate::spectral::{
-    BinDistribution, Lambdas, Readout, bin_importance, for_each_rotated,
-};
+use crate::spectral::{BinDistribution, Lambdas, Readout, bin_importance, for_each_rotated};
 
 use super::{Shading, sample_direct};
 
@@ -138,7 +136,7 @@ impl PathTracer {
                 } else {
                     for i in 0..N {
                         let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
-                        split = split + self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
+                        split += self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
                     }
                     break;
                 }
@@ -175,7 +173,7 @@ impl PathTracer {
                 if sampler.next_1d() >= q {
                     break;
                 }
-                w.beta = w.beta / q;
+                w.beta /= q;
             }
             ray = Ray::spawn(hit.p, hit.n, wi);
             match scene.intersect(&ray, f32::INFINITY) {
@@ -183,7 +181,7 @@ impl PathTracer {
                 None => break,
             }
         }
-        lambdas.to_xyz(&l) + split
+        lambdas.xyz(&l) + split
     }
 }
 
@@ -234,7 +232,7 @@ impl PathTracer {
                 total += v;
                 reflected += v * fr[i];
             }
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return None;
             }
             ((reflected / total).clamp(0.0, 1.0), Some(fr))
@@ -253,7 +251,7 @@ impl PathTracer {
             };
             let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
-            *split = *split + self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
+            *split += self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
         });
         None
     }

@@ -9,11 +9,11 @@
 //! wavelength like 589.3 nm (no rainbow), as in the `path` integrator: its
 //! packets are the full spectrum, which a BxDF samples at that wavelength.
 
+use crate::color::Sampled;
 use crate::color::Xyz;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::color::Sampled;
 use crate::spectral::Lambdas;
 
 use super::{Shading, sample_direct};
@@ -65,6 +65,6 @@ impl Whitted {
             bounces += 1;
             ray = Ray::spawn(hit.p, hit.n, wi);
         }
-        lambdas.to_xyz(&l)
+        lambdas.xyz(&l)
     }
 }

@@ -90,4 +90,3 @@ fn load_obj(data: &[u8], path: &Path) -> Result<MeshData> {
     let normals = (all_normals && !normals.is_empty()).then_some(normals);
     Ok(MeshData { positions, triangles: indices, normals })
 }
-

@@ -115,10 +115,10 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
         .iter()
         .position(|p| (p.name == "vertex_indices" || p.name == "vertex_index") && matches!(p.kind, Kind::List(..)))
         .ok_or_else(|| err("PLY 'face' element has no list property 'vertex_indices' or 'vertex_index'".into()))?;
-    if let Kind::List(c, i) = fe.props[face_list].kind {
-        if !c.is_int() || !i.is_int() {
-            return Err(err("PLY face list must have integer count and index types".into()));
-        }
+    if let Kind::List(c, i) = fe.props[face_list].kind
+        && (!c.is_int() || !i.is_int())
+    {
+        return Err(err("PLY face list must have integer count and index types".into()));
     }
     let layout = Layout { xyz, normal, face_list };
     // The header can claim any count: reserve no more than the body can hold (every

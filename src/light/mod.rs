@@ -122,9 +122,9 @@ fn sides(two_sided: bool) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shape::{Disk, Sphere};
     use crate::geometry::{Hit, Ray};
     use crate::sampler::Sampler;
+    use crate::shape::{Disk, Sphere};
 
     /// ∫ pdf_li dω over all directions from `p`, estimated with `n` uniform
     /// directions; `hit` intersects the light's shape.
@@ -167,7 +167,7 @@ mod tests {
     #[test]
     fn disk_light_pdf_integrates_to_one() {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
-        let light = Light::Disk(DiskLight { disk: disk.clone(), radiance: Spectrum::ONE, two_sided: false });
+        let light = Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: false });
         let p = Vec3::new(0.5, 0.0, -0.2);
         let integral = pdf_integral(&light, |r| disk.intersect(r, f32::INFINITY), p, 2, 200_000);
         assert!((integral - 1.0).abs() < 0.04, "∫pdf = {integral}");
@@ -179,8 +179,8 @@ mod tests {
 #[cfg(test)]
 mod stability_tests {
     use super::*;
-    use crate::shape::{Disk, Sphere};
     use crate::sampler::Sampler;
+    use crate::shape::{Disk, Sphere};
 
     /// A two-sided sphere light seen from inside is sampled by area: its pdf
     /// (per solid angle) integrates to 1 over all directions, since every
@@ -215,7 +215,7 @@ mod stability_tests {
     #[test]
     fn two_sided_disk_pdf_integrates_to_one_from_both_sides() {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
-        let light = Light::Disk(DiskLight { disk: disk.clone(), radiance: Spectrum::ONE, two_sided: true });
+        let light = Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: true });
         for (seed, p) in [(3, Vec3::new(0.5, 0.0, -0.2)), (4, Vec3::new(-0.3, 1.6, 0.1))] {
             let integral = super::tests::pdf_integral(&light, |r| disk.intersect(r, f32::INFINITY), p, seed, 200_000);
             assert!((integral - 1.0).abs() < 0.04, "from {p}: ∫pdf = {integral}");
@@ -238,7 +238,11 @@ mod stability_tests {
             for d in [1.0f32, 1e3] {
                 let r = ratio * d;
                 let centre = Vec3::new(0.3, 0.2 + d, -0.1);
-                let light = Light::Sphere(SphereLight { sphere: Sphere::new(centre, r), radiance: Spectrum::ONE, two_sided: false });
+                let light = Light::Sphere(SphereLight {
+                    sphere: Sphere::new(centre, r),
+                    radiance: Spectrum::ONE,
+                    two_sided: false,
+                });
                 let p = Vec3::new(0.3, 0.2, -0.1);
                 let n = 4000;
                 let mut e = 0.0f64;

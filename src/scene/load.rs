@@ -13,9 +13,9 @@ use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, Oren
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
+use crate::light::{DiskLight, Light, PointLight, SphereLight};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
-use crate::light::{DiskLight, Light, PointLight, SphereLight};
 
 /// The largest coordinate or size a scene may give: squares and products of a few
 /// such numbers must stay finite in f32 (max 3.4e38), or intersections and light
@@ -267,10 +267,8 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
             Some(e) => {
                 let radiance = ctx.spectrum(&format!("{field}.emission"), e)?;
                 let l = match &shape {
-                    Shape::Sphere(s) => {
-                        Light::Sphere(SphereLight { sphere: s.clone(), radiance, two_sided: o.two_sided })
-                    }
-                    Shape::Disk(d) => Light::Disk(DiskLight { disk: d.clone(), radiance, two_sided: o.two_sided }),
+                    Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided: o.two_sided }),
+                    Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided: o.two_sided }),
                     _ => return Err(ctx.err(format!("{field}.emission"), "only Sphere and Disk shapes can emit")),
                 };
                 lights.push(l);

@@ -12,13 +12,13 @@ mod load;
 
 pub use load::{load_scene, load_scene_str};
 
-use crate::shape::Bvh;
 use crate::bxdf::Bxdf;
 use crate::camera::Camera;
 use crate::geometry::{Hit, Ray};
-use crate::shape::Shape;
 use crate::light::Light;
 use crate::settings::Settings;
+use crate::shape::Bvh;
+use crate::shape::Shape;
 
 /// Below this many bounded objects the scene tests them one by one instead of
 /// building a BVH over them. Measured with callgrind (instructions for a 32x32,

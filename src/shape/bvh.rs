@@ -222,11 +222,11 @@ impl Bvh {
             if node.count > 0 {
                 let start = node.offset;
                 for k in start..start + node.count as u32 {
-                    if let Some((t, h)) = hit(k, t_max) {
-                        if t < t_max {
-                            t_max = t;
-                            best = Some(h);
-                        }
+                    if let Some((t, h)) = hit(k, t_max)
+                        && t < t_max
+                    {
+                        t_max = t;
+                        best = Some(h);
                     }
                 }
             } else {

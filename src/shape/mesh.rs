@@ -107,10 +107,10 @@ impl Mesh {
         if !(det != 0.0 && det.is_finite() && transform.translate.is_finite()) {
             return Err(err(format!("transform {transform:?} is singular or not finite")));
         }
-        if let Some(ns) = &normals {
-            if ns.len() != positions.len() {
-                return Err(err(format!("{} normals for {} vertices", ns.len(), positions.len())));
-            }
+        if let Some(ns) = &normals
+            && ns.len() != positions.len()
+        {
+            return Err(err(format!("{} normals for {} vertices", ns.len(), positions.len())));
         }
         for (i, p) in positions.iter_mut().enumerate() {
             if !p.is_finite() {

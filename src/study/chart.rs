@@ -76,7 +76,10 @@ pub fn draw(stem: &Path, chart: &Chart, series: &[Series]) -> Result<()> {
     });
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
-    let fail = |path: &Path, e: &dyn std::fmt::Display| Error::Image { path: path.to_path_buf(), message: format!("chart: {e}") };
+    let fail = |path: &Path, e: &dyn std::fmt::Display| Error::Image {
+        path: path.to_path_buf(),
+        message: format!("chart: {e}"),
+    };
     {
         let root = BitMapBackend::new(&png, CHART_SIZE).into_drawing_area();
         draw_on(&root, chart, series).map_err(|e| fail(&png, &e))?;
@@ -120,13 +123,7 @@ fn draw_on<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart, ser
     if chart.log_y { plot(root, chart, series, xs, yr.log_scale()) } else { plot(root, chart, series, xs, yr) }
 }
 
-fn plot<DB, Y>(
-    root: &DrawingArea<DB, Shift>,
-    chart: &Chart,
-    series: &[Series],
-    xs: Range<f64>,
-    y: Y,
-) -> DrawResult<DB>
+fn plot<DB, Y>(root: &DrawingArea<DB, Shift>, chart: &Chart, series: &[Series], xs: Range<f64>, y: Y) -> DrawResult<DB>
 where
     DB: DrawingBackend,
     Y: AsRangedCoord<Value = f64>,
@@ -137,8 +134,7 @@ where
         .margin(15)
         .x_label_area_size(50)
         .y_label_area_size(90)
-        .build_cartesian_2d(xs.log_scale(), y)
-        ?;
+        .build_cartesian_2d(xs.log_scale(), y)?;
     c.configure_mesh()
         .x_desc(&chart.x_label)
         .y_desc(&chart.y_label)
@@ -148,8 +144,7 @@ where
         .axis_desc_style(("sans-serif", 18))
         .x_label_formatter(&|v| short(*v))
         .y_label_formatter(&|v| short(*v))
-        .draw()
-        ?;
+        .draw()?;
     let ok = |v: f64| v.is_finite();
     for (i, s) in series.iter().enumerate() {
         let col = colour(i);
@@ -160,8 +155,7 @@ where
             c.draw_series(std::iter::once(Polygon::new(band, col.mix(0.18).filled())))?;
         }
         let line: Vec<(f64, f64)> = s.points.iter().filter(|p| ok(p.0) && ok(p.2)).map(|p| (p.0, p.2)).collect();
-        c.draw_series(LineSeries::new(line.clone(), col.stroke_width(2)))
-            ?
+        c.draw_series(LineSeries::new(line.clone(), col.stroke_width(2)))?
             .label(s.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(3)));
         c.draw_series(line.into_iter().map(|p| Circle::new(p, 3, col.filled())))?;
@@ -175,8 +169,7 @@ where
         .border_style(BLACK.mix(0.4))
         .label_font(("sans-serif", 16))
         .position(if chart.legend_middle { SeriesLabelPosition::MiddleRight } else { SeriesLabelPosition::UpperRight })
-        .draw()
-        ?;
+        .draw()?;
     Ok(())
 }
 

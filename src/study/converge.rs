@@ -18,9 +18,9 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
+use super::metrics::{Image, Metrics, Ratios, measure};
 use crate::error::{Error, Result};
 use crate::film::Film;
-use super::metrics::{Image, Metrics, Ratios, measure};
 use crate::render::{Limits, render};
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, WavelengthsKind};
