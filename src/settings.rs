@@ -124,10 +124,10 @@ mod by_name {
     }
 }
 
-/// Declares every setting once: name, type, default, doc, and how the
-/// checkpoint encodes it.
+/// Declares every setting once: name, type, default, doc, the constraint
+/// its value must meet, and (optionally) how the checkpoint encodes it.
 macro_rules! settings {
-    ($($(#[doc = $doc:literal])+ $field:ident: $ty:ty = $default:expr $(, serde($($serde:tt)*))?;)+) => {
+    ($($(#[doc = $doc:literal])+ $field:ident: $ty:ty = $default:expr, check($check:path) $(, serde($($serde:tt)*))?;)+) => {
         /// The complete settings of a render (defaults, the scene file's
         /// `render` block and the command line, combined).
         #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -142,6 +142,14 @@ macro_rules! settings {
         pub struct SettingsPatch {
             $($(#[doc = $doc])+ pub $field: Option<$ty>,)+
         }
+
+        /// Every setting's name, doc and choices, in declaration order (the
+        /// command line builds its flags from it).
+        pub const FIELDS: &[Field] = &[$(Field {
+            name: stringify!($field),
+            doc: concat!($($doc),+),
+            choices: <$ty as Value>::CHOICES,
+        },)+];
 
         impl Default for Settings {
             fn default() -> Self {
@@ -165,59 +173,32 @@ macro_rules! settings {
 
             /// `(field, value)` for every field, values as in a scene file.
             pub fn fields(&self) -> Vec<(&'static str, String)> {
-                vec![$((stringify!($field), Value::text(&self.$field)),)+]
+                vec![$((stringify!($field), self.$field.text()),)+]
+            }
+
+            /// The first setting out of range, as `(field, what was expected)`.
+            pub fn check(&self) -> Result<(), (&'static str, String)> {
+                $($check(&self.$field).map_err(|m| (stringify!($field), m))?;)+
+                Ok(())
+            }
+        }
+
+        impl SettingsPatch {
+            /// Sets field `name` from its text (as in a scene file or on the
+            /// command line), checking the value's constraint.
+            pub fn set(&mut self, name: &str, text: &str) -> Result<(), String> {
+                match name {
+                    $(stringify!($field) => {
+                        let v = <$ty as Value>::parse(text)?;
+                        $check(&v)?;
+                        self.$field = Some(v);
+                        Ok(())
+                    })+
+                    _ => Err(format!("unknown setting {name:?}")),
+                }
             }
         }
     };
-}
-
-settings! {
-    /// Image width in pixels (default 512).
-    width: u32 = 512;
-    /// Image height in pixels (default 512).
-    height: u32 = 512;
-    /// Samples per pixel = passes (default 64).
-    spp: u32 = 64;
-    /// Seed of the deterministic sampler (default 0).
-    seed: u64 = 0;
-    /// Maximum number of scattering events on a path (default 8; see [`crate::integrator`]).
-    max_bounces: u32 = 8;
-    /// Integrator: `auto`, `path`, `whitted` or `spectral` (default `auto`).
-    integrator: IntegratorKind = IntegratorKind::Auto, serde(with = "by_name");
-    /// Wavelength sampling of the `spectral` integrator: `hero`, `random` or `rgb` (default `hero`).
-    wavelengths: WavelengthsKind = WavelengthsKind::Hero, serde(with = "by_name");
-    /// Wavelengths per packet of the `spectral` integrator, and the wavelengths
-    /// `auto` draws where a path refracts into dispersive glass: 1, 2, 4 or 8 (default 4).
-    packet_size: u32 = 4;
-}
-
-/// A setting's value as text.
-trait Value {
-    fn text(&self) -> String;
-}
-
-impl Value for u32 {
-    fn text(&self) -> String {
-        self.to_string()
-    }
-}
-
-impl Value for u64 {
-    fn text(&self) -> String {
-        self.to_string()
-    }
-}
-
-impl Value for IntegratorKind {
-    fn text(&self) -> String {
-        self.name().into()
-    }
-}
-
-impl Value for WavelengthsKind {
-    fn text(&self) -> String {
-        self.name().into()
-    }
 }
 
 /// The largest image side, in pixels.
@@ -226,27 +207,105 @@ pub const MAX_SIDE: u32 = 1 << 15;
 /// The packet sizes the integrators are compiled for.
 pub const PACKET_SIZES: [u32; 4] = [1, 2, 4, 8];
 
+settings! {
+    /// Image width in pixels (default 512).
+    width: u32 = 512, check(side);
+    /// Image height in pixels (default 512).
+    height: u32 = 512, check(side);
+    /// Samples per pixel; one pass adds one sample to every pixel (default 64).
+    spp: u32 = 64, check(positive);
+    /// Seed of the deterministic sampler (default 0).
+    seed: u64 = 0, check(any);
+    /// Maximum scattering events per path, as pbrt's maxdepth; Mitsuba's max_depth is one more (default 8).
+    max_bounces: u32 = 8, check(any);
+    /// Light transport method (default auto).
+    integrator: IntegratorKind = IntegratorKind::Auto, check(any), serde(with = "by_name");
+    /// Wavelength sampling of the spectral integrator (default hero).
+    wavelengths: WavelengthsKind = WavelengthsKind::Hero, check(any), serde(with = "by_name");
+    /// Wavelengths per packet of the spectral integrator, and the wavelengths auto draws where a path refracts into dispersive glass: 1, 2, 4 or 8 (default 4).
+    packet_size: u32 = 4, check(packet_size);
+}
+
+/// What the command line needs to know of one setting.
+#[derive(Clone, Copy, Debug)]
+pub struct Field {
+    /// The name in the scene file (`max_bounces`); the flag is `--max-bounces`.
+    pub name: &'static str,
+    /// What it means, with its default.
+    pub doc: &'static str,
+    /// The values it takes, when they are a closed set of names.
+    pub choices: &'static [&'static str],
+}
+
+fn any<T>(_: &T) -> Result<(), String> {
+    Ok(())
+}
+
+fn positive(v: &u32) -> Result<(), String> {
+    if *v == 0 { Err("expected a positive number, found 0".into()) } else { Ok(()) }
+}
+
+fn side(v: &u32) -> Result<(), String> {
+    positive(v)?;
+    if *v > MAX_SIDE { Err(format!("expected at most {MAX_SIDE} pixels per side, found {v}")) } else { Ok(()) }
+}
+
+fn packet_size(v: &u32) -> Result<(), String> {
+    if PACKET_SIZES.contains(v) { Ok(()) } else { Err(format!("expected 1, 2, 4 or 8, found {v}")) }
+}
+
+/// A setting's value as text, both ways.
+trait Value: Sized {
+    /// The closed set of names it takes (empty for numbers).
+    const CHOICES: &'static [&'static str];
+    fn text(&self) -> String;
+    fn parse(s: &str) -> Result<Self, String>;
+}
+
+impl Value for u32 {
+    const CHOICES: &'static [&'static str] = &[];
+    fn text(&self) -> String {
+        self.to_string()
+    }
+    fn parse(s: &str) -> Result<Self, String> {
+        s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", u32::MAX))
+    }
+}
+
+impl Value for u64 {
+    const CHOICES: &'static [&'static str] = &[];
+    fn text(&self) -> String {
+        self.to_string()
+    }
+    fn parse(s: &str) -> Result<Self, String> {
+        s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", u64::MAX))
+    }
+}
+
+impl Value for IntegratorKind {
+    const CHOICES: &'static [&'static str] = IntegratorKind::NAMES;
+    fn text(&self) -> String {
+        self.name().into()
+    }
+    fn parse(s: &str) -> Result<Self, String> {
+        Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
+    }
+}
+
+impl Value for WavelengthsKind {
+    const CHOICES: &'static [&'static str] = WavelengthsKind::NAMES;
+    fn text(&self) -> String {
+        self.name().into()
+    }
+    fn parse(s: &str) -> Result<Self, String> {
+        Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
+    }
+}
+
 impl Settings {
     /// Defaults, then `file` (the scene's `render` block), then `cli`.
     pub fn combine(file: &SettingsPatch, cli: &SettingsPatch) -> Settings {
         Settings::default().apply(file).apply(cli)
-    }
-
-    /// The first setting out of range, as `(field, what was expected)`.
-    pub fn check(&self) -> Result<(), (&'static str, String)> {
-        for (name, v) in [("width", self.width), ("height", self.height), ("spp", self.spp)] {
-            if v == 0 {
-                return Err((name, "expected a positive number, found 0".into()));
-            }
-        }
-        if self.width > MAX_SIDE || self.height > MAX_SIDE {
-            let name = if self.width > MAX_SIDE { "width" } else { "height" };
-            return Err((name, format!("expected at most {MAX_SIDE} pixels per side")));
-        }
-        if !PACKET_SIZES.contains(&self.packet_size) {
-            return Err(("packet_size", format!("expected 1, 2, 4 or 8, found {}", self.packet_size)));
-        }
-        Ok(())
     }
 
     /// The settings that differ from `other`'s, as `name other vs self`,
@@ -283,6 +342,25 @@ mod tests {
             assert_eq!(WavelengthsKind::from_name(k.name()), Some(*k));
         }
         assert_eq!(IntegratorKind::from_name("bdpt"), None);
+    }
+
+    #[test]
+    fn set_parses_and_checks_each_field() {
+        let mut p = SettingsPatch::default();
+        p.set("max_bounces", "12").unwrap();
+        p.set("integrator", "spectral").unwrap();
+        assert_eq!((p.max_bounces, p.integrator), (Some(12), Some(IntegratorKind::Spectral)));
+        assert!(p.set("width", "0").unwrap_err().contains("positive"));
+        assert!(p.set("width", "40000").unwrap_err().contains("at most 32768"));
+        assert!(p.set("packet_size", "3").unwrap_err().contains("1, 2, 4 or 8"));
+        assert!(p.set("seed", "-1").unwrap_err().contains("whole number"));
+        assert!(p.set("integrator", "bdpt").unwrap_err().contains("auto, path, whitted, spectral"));
+        assert!(p.set("focus", "1").is_err());
+        assert_eq!(
+            FIELDS.iter().map(|f| f.name).collect::<Vec<_>>(),
+            Settings::default().fields().iter().map(|f| f.0).collect::<Vec<_>>()
+        );
+        assert_eq!(FIELDS[5].choices, IntegratorKind::NAMES);
     }
 
     #[test]

@@ -5,10 +5,10 @@
 use std::ops::Range;
 use std::path::PathBuf;
 
-use clap::builder::{PossibleValuesParser, TypedValueParser};
-use clap::{Args, Parser, Subcommand};
+use clap::builder::PossibleValuesParser;
+use clap::{ArgMatches, Args, FromArgMatches, Parser, Subcommand};
 
-use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
+use rust_v::settings::{FIELDS, SettingsPatch};
 
 /// rust-v: a physically based spectral path tracer.
 #[derive(Debug, Parser)]
@@ -186,47 +186,63 @@ fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// Render settings shared by the subcommands that render.
-#[derive(Debug, Args, Clone, Default)]
-pub struct SettingsArgs {
-    /// Samples per pixel (one pass adds one sample to every pixel).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
-    pub spp: Option<u32>,
-    /// Seed of the deterministic sampler.
-    #[arg(long)]
-    pub seed: Option<u64>,
-    /// Image width in pixels.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub width: Option<u32>,
-    /// Image height in pixels.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=32768))]
-    pub height: Option<u32>,
-    /// Maximum scattering events per path (pbrt's maxdepth; Mitsuba's max_depth minus 1).
-    #[arg(long)]
-    pub max_bounces: Option<u32>,
-    /// Light transport method.
-    #[arg(long, value_parser = PossibleValuesParser::new(IntegratorKind::NAMES).map(|s| IntegratorKind::from_name(&s).unwrap_or(IntegratorKind::Auto)))]
-    pub integrator: Option<IntegratorKind>,
-    /// Wavelength sampling of the spectral integrator.
-    #[arg(long, value_parser = PossibleValuesParser::new(WavelengthsKind::NAMES).map(|s| WavelengthsKind::from_name(&s).unwrap_or(WavelengthsKind::Hero)))]
-    pub wavelengths: Option<WavelengthsKind>,
-    /// Wavelengths per packet of the spectral integrator, and the wavelengths `auto` draws where a path refracts into dispersive glass (1, 2, 4 or 8).
-    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["1", "2", "4", "8"]).map(|s| s.parse::<u32>().unwrap_or(4)))]
-    pub packet_size: Option<u32>,
-}
+/// Render settings shared by the subcommands that render: one flag per
+/// setting of [`rust_v::settings::FIELDS`] (`max_bounces` is
+/// `--max-bounces`), with the setting's doc as help and its constraint
+/// checked as the value is parsed. Not derived: the settings are defined
+/// once, in the library, which knows nothing of clap.
+#[derive(Debug, Clone, Default)]
+pub struct SettingsArgs(pub SettingsPatch);
 
 impl SettingsArgs {
     /// The overrides in the scene format's terms.
     pub fn overrides(&self) -> SettingsPatch {
-        SettingsPatch {
-            width: self.width,
-            height: self.height,
-            spp: self.spp,
-            seed: self.seed,
-            max_bounces: self.max_bounces,
-            integrator: self.integrator,
-            wavelengths: self.wavelengths,
-            packet_size: self.packet_size,
+        self.0.clone()
+    }
+
+    /// Whether `--spp` was given.
+    pub fn spp_given(&self) -> bool {
+        self.0.spp.is_some()
+    }
+}
+
+/// `max_bounces` -> `max-bounces`.
+fn flag(name: &str) -> String {
+    name.replace('_', "-")
+}
+
+impl Args for SettingsArgs {
+    fn augment_args(mut cmd: clap::Command) -> clap::Command {
+        for f in FIELDS {
+            let name = f.name;
+            let arg = clap::Arg::new(name).long(flag(name)).value_name(name.to_uppercase()).help(f.doc.trim());
+            cmd = cmd.arg(if f.choices.is_empty() {
+                arg.value_parser(move |s: &str| SettingsPatch::default().set(name, s).map(|()| s.to_string()))
+            } else {
+                arg.value_parser(PossibleValuesParser::new(f.choices))
+            });
         }
+        cmd
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl FromArgMatches for SettingsArgs {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let mut s = SettingsArgs::default();
+        s.update_from_arg_matches(m)?;
+        Ok(s)
+    }
+
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        for f in FIELDS {
+            if let Some(v) = m.get_one::<String>(f.name) {
+                self.0.set(f.name, v).map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
+            }
+        }
+        Ok(())
     }
 }

@@ -44,7 +44,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         );
     }
     // With a time budget and no --spp (or --passes), render until the time is up.
-    let open_ended = args.time.is_some() && args.settings.spp.is_none() && args.passes.is_none();
+    let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
     let checkpoint = Checkpoint {
