@@ -3,7 +3,7 @@
 //!
 //! A render can be stopped and resumed, or split into pass ranges rendered
 //! by different processes and merged, with bit-identical results: the
-//! sampler is keyed by `(seed, pixel, pass)` ([`crate::sampler`]) and the
+//! sampler is keyed by `(seed, pixel, pass)` (the crate-internal `sampler`) and the
 //! film's fixed-point sums are exactly associative ([`crate::film`]), so a
 //! checkpoint only has to hold whole passes, their range, the settings, and
 //! which scene they belong to.
@@ -24,7 +24,7 @@
 //! Reading checks the magic, the version, the exact length (a truncated
 //! file is reported as such), the checksum, then decodes and validates every
 //! field; any failure is an [`Error::Checkpoint`] naming the file. Writing
-//! goes through [`crate::io::atomic_file`], so the file on disk is always a
+//! goes through [`crate::io::write_atomic`], so the file on disk is always a
 //! complete old or new checkpoint. bincode is used in this module only.
 
 use std::ops::Range;

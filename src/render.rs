@@ -11,7 +11,7 @@
 //! pass, a few per cent of the time.
 //!
 //! Sample `k` of pixel `p` draws its random numbers from the stream
-//! `(seed, p, k)` ([`crate::sampler`]) and the film's sums are exact integers,
+//! `(seed, p, k)` (the crate-internal `sampler`) and the film's sums are exact integers,
 //! so the image is bit-identical for any thread count, tile order or batch
 //! size, and a render of passes `a..b` is exactly the corresponding part of
 //! a longer render. No locks or atomics are touched per sample (one relaxed

@@ -1,7 +1,7 @@
 //! Render settings: the one definition that the scene file's `render` block,
 //! the command-line overrides and the checkpoint header all use.
 //!
-//! Every setting is listed once, in the [`settings!`] invocation below, with
+//! Every setting is listed once, in the `settings!` invocation below, with
 //! its type, default and doc. From that list come:
 //! - [`Settings`], the complete settings of a render (what a checkpoint
 //!   stores, what the integrators read);
@@ -73,7 +73,7 @@ named_enum! {
 }
 
 named_enum! {
-    /// Wavelength sampling of the `spectral` integrator ([`crate::spectral`]).
+    /// Wavelength sampling of the `spectral` integrator (`crate::spectral`).
     WavelengthsKind {
         /// One uniform hero bin, the others at equal rotation.
         Hero = "hero",

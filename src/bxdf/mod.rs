@@ -4,7 +4,7 @@
 //! All directions are in the local shading frame, where the surface normal is
 //! `+z`; `wo` points back along the path (towards the camera side), `wi` is the
 //! sampled or queried direction; both point away from the surface and are unit.
-//! Values come for a packet of `N` wavelengths ([`Lambdas`]).
+//! Values come for a packet of `N` wavelengths (`Lambdas`, in the crate-internal `spectral` module).
 //!
 //! - [`Bxdf::eval`]`(wo, wi)` is `f(wo, wi)` without the cosine; 0 for delta
 //!   models (their value lives only in `sample`).

@@ -1,8 +1,10 @@
 //! Colour: 36-bin spectra, CIE 1931 colorimetry, sRGB conversion and named spectra.
 //!
-//! The renderer transports light as [`Spectrum`] values (380-730 nm, 10 nm bins), converts to
-//! CIE XYZ with the normalised colour matching functions in [`cie`], and to sRGB with the same
-//! matrix as Mitsuba 3 ([`rgb`]). [`named`] holds the spectra a scene file can refer to.
+//! The renderer transports light as [`Spectrum`] values (380-730 nm, 10 nm bins; the one
+//! spectral arithmetic, [`Sampled`], in `spectrum.rs`), converts to CIE XYZ with the
+//! normalised colour matching functions ([`CMF_NORMALISED`], `cie.rs`), and to sRGB with the
+//! same matrix as Mitsuba 3 ([`XYZ_TO_LINEAR_SRGB`], `rgb.rs`). `named.rs` holds the spectra a
+//! scene file can refer to ([`color_checker`], [`d65`], [`blackbody`]).
 
 mod cie;
 mod named;

@@ -15,7 +15,7 @@ pub struct Hit {
     /// in the same hemisphere as `n`), else equal to `n`.
     pub ns: Vec3,
     /// Triangle index for meshes (in the mesh's storage order, see
-    /// [`Mesh::triangle`](super::Mesh::triangle)), 0 for other shapes.
+    /// [`Mesh::triangle`](crate::shape::Mesh::triangle)), 0 for other shapes.
     pub prim: u32,
 }
 

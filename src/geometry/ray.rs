@@ -59,7 +59,7 @@ fn next_down(x: f32) -> f32 {
 
 /// The origin for a ray leaving surface point `p` (unit geometric normal `n`) in
 /// direction `dir`: `p` moved along `±n`, towards the side `dir` points to, by
-/// `d = max(|p.x|, |p.y|, |p.z|) * 2^-20 + 1e-20` (see [`ORIGIN_REL_ERROR`]), each
+/// `d = max(|p.x|, |p.y|, |p.z|) * 2^-20 + 1e-20` (see `ORIGIN_REL_ERROR`), each
 /// coordinate then rounded one more ulp away from `p`. Since the error bound scales
 /// with the coordinates, a scene scaled by 1e-4 or 1e4 or moved far from the origin
 /// behaves the same.
@@ -103,7 +103,7 @@ impl Ray {
 
     /// A shadow ray from surface point `p` (normal `n`) towards point `target`; returns
     /// the ray and the `t_max` to use so that the target's own surface is not hit: the
-    /// distance shortened by [`SHADOW_EPSILON`] relative and by the target's own
+    /// distance shortened by `SHADOW_EPSILON` relative and by the target's own
     /// coordinate error bound. Coincident points give `t_max = 0`.
     #[inline]
     pub fn spawn_to(p: Vec3, n: Vec3, target: Vec3) -> (Ray, f32) {

@@ -10,7 +10,7 @@
 //! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
-//! ([`crate::spectral`]), and picked once per render ([`Estimator`]) so the
+//! (the crate-internal `spectral` module), and picked once per render ([`Estimator`]) so the
 //! tile loop is monomorphic.
 //!
 //! # Depth

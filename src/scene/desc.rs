@@ -1,7 +1,7 @@
 //! The scene file format: serde structures that *are* the RON format.
 //!
 //! Every struct denies unknown fields, so a misspelt field is an error with
-//! its line:column, never silently ignored. [`super::load`] turns a
+//! its line:column, never silently ignored. [`super::load_scene`] turns a
 //! [`SceneDesc`] into a [`super::Scene`], checking names and sizes.
 //!
 //! A complete example (`scenes/cornell.ron` is the full one):

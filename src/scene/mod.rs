@@ -1,6 +1,6 @@
 //! The scene: objects, materials, lights and camera, ready to render.
 //!
-//! Data flow: the RON file ([`desc`]) is parsed and checked by [`load`] into a
+//! Data flow: the RON file ([`desc`]) is parsed and checked by [`load_scene`] into a
 //! [`Scene`]; the renderer asks it for the closest hit along a ray
 //! ([`Scene::intersect`]) and whether a shadow ray is blocked
 //! ([`Scene::occluded`]). Bounded objects sit in a BVH over their bounds
