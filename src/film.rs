@@ -58,7 +58,7 @@ const SCALE: f64 = 18446744073709551616.0; // 2^64
 /// f64 → i128 conversion, which made the (serial) film update a tenth of a
 /// sample's cost.
 #[inline]
-pub fn to_fixed(v: f32) -> i128 {
+pub(crate) fn to_fixed(v: f32) -> i128 {
     let v = v.clamp(-MAX_SAMPLE, MAX_SAMPLE);
     let bits = v.to_bits();
     let exp = ((bits >> 23) & 0xff) as i32;
@@ -83,13 +83,13 @@ pub fn to_fixed(v: f32) -> i128 {
 
 /// A fixed-point sum as an f64 (rounded to nearest).
 #[inline]
-pub fn from_fixed(v: i128) -> f64 {
+pub(crate) fn from_fixed(v: i128) -> f64 {
     v as f64 / SCALE
 }
 
 /// A rectangle of pixels `[x0, x1) × [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Tile {
+pub(crate) struct Tile {
     /// First column.
     pub x0: u32,
     /// First row.
@@ -105,15 +105,10 @@ impl Tile {
     pub fn len(&self) -> usize {
         ((self.x1 - self.x0) * (self.y1 - self.y0)) as usize
     }
-
-    /// True for an empty tile.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
 }
 
 /// Splits a `width × height` image into tiles of at most `size × size`, row-major.
-pub fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
+pub(crate) fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
     let mut out = Vec::new();
     for y0 in (0..height).step_by(size as usize) {
         for x0 in (0..width).step_by(size as usize) {
@@ -207,8 +202,11 @@ impl Film {
     /// Adds one sample per pixel of `tile` (row-major within the tile).
     /// Returns the number of invalid samples: non-finite ones are dropped,
     /// ones beyond ±[`MAX_SAMPLE`] are clamped. Both are counted and reported
-    /// by the renderer: they are bugs, never expected.
-    pub fn add_tile(&mut self, tile: &Tile, samples: &[Xyz]) -> usize {
+    /// by the renderer: they are bugs, never expected. (The renderer adds
+    /// whole batches with [`Film::add_tiles_parallel`]; this is the tests'
+    /// tile-by-tile reference.)
+    #[cfg(test)]
+    pub(crate) fn add_tile(&mut self, tile: &Tile, samples: &[Xyz]) -> usize {
         add_tile_to_rows(&mut self.sums, self.width, 0, tile, samples)
     }
 
@@ -220,7 +218,7 @@ impl Film {
     /// on the order of the additions, so the sums are those of adding tile by
     /// tile, pass by pass. The caller records the passes with `end_pass`.
     /// Returns the invalid samples.
-    pub fn add_tiles_parallel(&mut self, tiles: &[Tile], samples: &[Vec<Xyz>], tile_size: u32) -> usize {
+    pub(crate) fn add_tiles_parallel(&mut self, tiles: &[Tile], samples: &[Vec<Xyz>], tile_size: u32) -> usize {
         use rayon::prelude::*;
         assert!(!tiles.is_empty() && samples.len().is_multiple_of(tiles.len()), "samples must hold whole passes");
         let width = self.width;

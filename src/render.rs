@@ -5,8 +5,8 @@
 //! (pass, tile) tasks, pass-major, each computing one sample per pixel of its
 //! tile into a buffer of its own; after the batch, bands of tile rows add the
 //! buffers to the film in parallel. A batch holds at least
-//! [`MIN_TASKS_PER_BATCH`] tasks where the passes allow it (at most
-//! [`MAX_PASSES_PER_BATCH`] passes): a barrier per pass over only 64 tiles
+//! `MIN_TASKS_PER_BATCH` tasks where the passes allow it (at most
+//! `MAX_PASSES_PER_BATCH` passes): a barrier per pass over only 64 tiles
 //! (a 128×128 image) left a thread idle for half a tile at the end of every
 //! pass, a few per cent of the time.
 //!
@@ -41,14 +41,14 @@ pub const TILE_SIZE: u32 = 16;
 /// A batch of passes holds at least this many (pass, tile) tasks when the
 /// passes allow: the idle tail at a batch's end is then about half a task in
 /// this many per thread.
-pub const MIN_TASKS_PER_BATCH: usize = 256;
+pub(crate) const MIN_TASKS_PER_BATCH: usize = 256;
 
 /// The most passes in one batch: bounds the time between snapshots,
 /// checkpoints and progress reports, and what a stop can discard.
-pub const MAX_PASSES_PER_BATCH: u32 = 16;
+pub(crate) const MAX_PASSES_PER_BATCH: u32 = 16;
 
 /// Passes per batch for an image of `tiles` tiles.
-pub fn passes_per_batch(tiles: usize) -> u32 {
+pub(crate) fn passes_per_batch(tiles: usize) -> u32 {
     (MIN_TASKS_PER_BATCH.div_ceil(tiles.max(1)) as u32).clamp(1, MAX_PASSES_PER_BATCH)
 }
 

@@ -10,7 +10,7 @@
 //! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
-//! (the crate-internal `spectral` module), and picked once per render ([`Estimator`]) so the
+//! (the crate-internal `spectral` module), and picked once per render (`Estimator`) so the
 //! tile loop is monomorphic.
 //!
 //! # Depth
@@ -39,14 +39,14 @@ use crate::spectral::{Lambdas, WavelengthSampling, sample_packet};
 
 /// Computes the colour of one camera sample. Implementations are chosen once
 /// per render and the render loop is generic over them.
-pub trait Estimator: Sync {
+pub(crate) trait Estimator: Sync {
     /// The XYZ estimate of one sample through film position `film` (pixel units).
     fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz;
 }
 
 /// The light-transport method, with its bounce limit.
 #[derive(Clone, Copy, Debug)]
-pub enum Transport {
+pub(crate) enum Transport {
     /// Whitted-style.
     Whitted(Whitted),
     /// Path tracing.
@@ -65,7 +65,7 @@ impl Transport {
 }
 
 /// Full spectrum on every path (the `path` and `whitted` integrators).
-pub struct FullSpectrum(pub Transport);
+pub(crate) struct FullSpectrum(pub Transport);
 
 impl Estimator for FullSpectrum {
     #[inline]
@@ -76,7 +76,7 @@ impl Estimator for FullSpectrum {
 }
 
 /// A packet of `C` sampled wavelengths per camera sample (the `spectral` integrator).
-pub struct Packets<const C: usize>(pub Transport, pub WavelengthSampling);
+pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling);
 
 impl<const C: usize> Estimator for Packets<C> {
     #[inline]
@@ -88,7 +88,7 @@ impl<const C: usize> Estimator for Packets<C> {
 }
 
 /// The three fixed wavelengths of the RGB mode.
-pub struct RgbWavelengths(pub Transport);
+pub(crate) struct RgbWavelengths(pub Transport);
 
 impl Estimator for RgbWavelengths {
     #[inline]
@@ -100,7 +100,7 @@ impl Estimator for RgbWavelengths {
 
 /// Calls `f` with the estimator the settings ask for: the one place where the
 /// integrator is chosen, outside the tile loop.
-pub fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> R {
+pub(crate) fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> R {
     let whitted = Transport::Whitted(Whitted { max_bounces: settings.max_bounces });
     let path = |disperse| {
         Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
@@ -147,7 +147,7 @@ pub fn describe(scene: &Scene) -> String {
 }
 
 /// A function generic over the estimator type (a closure cannot be generic).
-pub trait EstimatorFn<R> {
+pub(crate) trait EstimatorFn<R> {
     /// Runs with estimator `e`.
     fn call<E: Estimator>(self, e: &E) -> R;
 }

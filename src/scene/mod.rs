@@ -25,7 +25,7 @@ use crate::shape::Shape;
 /// 4-spp render, one thread): cornell.ron (7 objects) 50.0 M linear vs 57.9 M
 /// with a BVH; spheres.ron (15 objects) 117.1 M linear vs 102.2 M with a BVH.
 /// The crossover lies between, so 8.
-pub const BVH_MIN_OBJECTS: usize = 8;
+pub(crate) const BVH_MIN_OBJECTS: usize = 8;
 
 /// An object: a shape with a material and possibly an emission.
 #[derive(Debug)]
