@@ -210,8 +210,8 @@ impl Checkpoint {
             return Err(bad("corrupt header: trailing bytes".into()));
         }
         let settings = h.settings;
-        if let Err((field, message)) = (Settings { spp: settings.spp.max(1), ..settings.clone() }).check() {
-            return Err(bad(format!("corrupt header: {field}: {message}")));
+        if let Err(e) = settings.check() {
+            return Err(bad(format!("corrupt header: {e}")));
         }
         if h.end_pass < h.first_pass {
             return Err(bad("corrupt header: invalid pass range".into()));

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{ArgMatches, Args, FromArgMatches, Parser, Subcommand};
 
+use rust_v::error::Error;
 use rust_v::settings::{FIELDS, SettingsPatch};
 
 /// rust-v: a physically based spectral path tracer.
@@ -168,21 +169,22 @@ pub struct MergeArgs {
 }
 
 /// `A..B` with A < B.
-fn parse_pass_range(s: &str) -> std::result::Result<Range<u32>, String> {
-    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B (e.g. 0..64), got {s:?}"))?;
-    let a: u32 = a.trim().parse().map_err(|e| format!("start {a:?}: {e}"))?;
-    let b: u32 = b.trim().parse().map_err(|e| format!("end {b:?}: {e}"))?;
+fn parse_pass_range(s: &str) -> Result<Range<u32>, Error> {
+    let bad = Error::Settings;
+    let (a, b) = s.split_once("..").ok_or_else(|| bad(format!("expected A..B (e.g. 0..64), got {s:?}")))?;
+    let a: u32 = a.trim().parse().map_err(|e| bad(format!("start {a:?}: {e}")))?;
+    let b: u32 = b.trim().parse().map_err(|e| bad(format!("end {b:?}: {e}")))?;
     if a >= b {
-        return Err(format!("{a}..{b} is empty: the end must be greater than the start"));
+        return Err(bad(format!("{a}..{b} is empty: the end must be greater than the start")));
     }
     Ok(a..b)
 }
 
 /// A positive, finite number of seconds.
-fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
+fn parse_seconds(s: &str) -> Result<f64, Error> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("expected a positive number of seconds, got {s:?}")),
+        _ => Err(Error::Settings(format!("expected a positive number of seconds, got {s:?}"))),
     }
 }
 
@@ -217,7 +219,13 @@ impl Args for SettingsArgs {
             let name = f.name;
             let arg = clap::Arg::new(name).long(flag(name)).value_name(name.to_uppercase()).help(f.doc.trim());
             cmd = cmd.arg(if f.choices.is_empty() {
-                arg.value_parser(move |s: &str| SettingsPatch::default().set(name, s).map(|()| s.to_string()))
+                arg.value_parser(move |s: &str| {
+                    SettingsPatch::default().set(name, s).map(|()| s.to_string()).map_err(|e| match e {
+                        // clap names the flag; the message says what was expected.
+                        Error::Setting { message, .. } => Error::Settings(message),
+                        e => e,
+                    })
+                })
             } else {
                 arg.value_parser(PossibleValuesParser::new(f.choices))
             });

@@ -308,6 +308,8 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
 /// Combines defaults, the file's `render` block and the command line, and checks the result.
 fn settings(ctx: &Ctx<'_>, file: &SettingsPatch, cli: &SettingsPatch) -> Result<Settings> {
     let s = Settings::combine(file, cli);
-    s.check().map_err(|(field, message)| ctx.err(format!("render.{field}"), message))?;
+    if let Err(Error::Setting { name, message }) = s.check() {
+        return Err(ctx.err(format!("render.{name}"), message));
+    }
     Ok(s)
 }
