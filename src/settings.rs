@@ -57,6 +57,16 @@ macro_rules! named_enum {
                 }
             }
         }
+
+        impl Value for $name {
+            const CHOICES: &'static [&'static str] = $name::NAMES;
+            fn text(&self) -> String {
+                self.name().into()
+            }
+            fn parse(s: &str) -> std::result::Result<Self, String> {
+                Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
+            }
+        }
     };
 }
 
@@ -86,43 +96,19 @@ named_enum! {
     }
 }
 
-/// Encodes a named enum as its name (binary formats: the checkpoint header).
+/// Encodes a setting's value as its text (binary formats: the checkpoint
+/// header stores the enums as their names).
 mod by_name {
     use serde::{Deserialize, Deserializer, Serializer, de::Error as _};
 
-    pub trait Named: Sized + Copy {
-        fn name(self) -> &'static str;
-        fn from_name(s: &str) -> Option<Self>;
-        const WHAT: &'static str;
+    use super::Value;
+
+    pub fn serialize<T: Value, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&v.text())
     }
 
-    impl Named for super::IntegratorKind {
-        fn name(self) -> &'static str {
-            super::IntegratorKind::name(self)
-        }
-        fn from_name(s: &str) -> Option<Self> {
-            super::IntegratorKind::from_name(s)
-        }
-        const WHAT: &'static str = "integrator";
-    }
-
-    impl Named for super::WavelengthsKind {
-        fn name(self) -> &'static str {
-            super::WavelengthsKind::name(self)
-        }
-        fn from_name(s: &str) -> Option<Self> {
-            super::WavelengthsKind::from_name(s)
-        }
-        const WHAT: &'static str = "wavelength sampling";
-    }
-
-    pub fn serialize<T: Named, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(v.name())
-    }
-
-    pub fn deserialize<'de, T: Named, D: Deserializer<'de>>(d: D) -> Result<T, D::Error> {
-        let s = String::deserialize(d)?;
-        T::from_name(&s).ok_or_else(|| D::Error::custom(format!("unknown {} {s:?}", T::WHAT)))
+    pub fn deserialize<'de, T: Value, D: Deserializer<'de>>(d: D) -> Result<T, D::Error> {
+        T::parse(&String::deserialize(d)?).map_err(D::Error::custom)
     }
 }
 
@@ -269,45 +255,22 @@ trait Value: Sized {
     fn parse(s: &str) -> std::result::Result<Self, String>;
 }
 
-impl Value for u32 {
-    const CHOICES: &'static [&'static str] = &[];
-    fn text(&self) -> String {
-        self.to_string()
-    }
-    fn parse(s: &str) -> std::result::Result<Self, String> {
-        s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", u32::MAX))
-    }
+/// Whole numbers as settings.
+macro_rules! number_value {
+    ($($ty:ty),+) => {$(
+        impl Value for $ty {
+            const CHOICES: &'static [&'static str] = &[];
+            fn text(&self) -> String {
+                self.to_string()
+            }
+            fn parse(s: &str) -> std::result::Result<Self, String> {
+                s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", <$ty>::MAX))
+            }
+        }
+    )+};
 }
 
-impl Value for u64 {
-    const CHOICES: &'static [&'static str] = &[];
-    fn text(&self) -> String {
-        self.to_string()
-    }
-    fn parse(s: &str) -> std::result::Result<Self, String> {
-        s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", u64::MAX))
-    }
-}
-
-impl Value for IntegratorKind {
-    const CHOICES: &'static [&'static str] = IntegratorKind::NAMES;
-    fn text(&self) -> String {
-        self.name().into()
-    }
-    fn parse(s: &str) -> std::result::Result<Self, String> {
-        Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
-    }
-}
-
-impl Value for WavelengthsKind {
-    const CHOICES: &'static [&'static str] = WavelengthsKind::NAMES;
-    fn text(&self) -> String {
-        self.name().into()
-    }
-    fn parse(s: &str) -> std::result::Result<Self, String> {
-        Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
-    }
-}
+number_value!(u32, u64);
 
 impl Settings {
     /// Defaults, then `file` (the scene's `render` block), then `cli`.

@@ -77,10 +77,17 @@ pub struct ConvergeArgs {
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub settings: SettingsArgs,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// How a command that renders runs: threads and what it prints.
+#[derive(Debug, Args, Clone, Default)]
+pub struct RunArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// No progress lines on stderr.
+    /// No progress bar, progress lines or summary on stderr (warnings still print).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -95,12 +102,8 @@ pub struct RenderArgs {
     pub output: Option<PathBuf>,
     #[command(flatten)]
     pub settings: SettingsArgs,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-    /// No progress bar or summary on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
     /// Render only passes A to B-1 (`A..B`), e.g. one job's share of a distributed render.
     #[arg(long, value_name = "A..B", value_parser = parse_pass_range)]
     pub passes: Option<Range<u32>>,
@@ -115,8 +118,9 @@ pub struct RenderArgs {
 /// Checkpoint flags shared by `render` and `resume`.
 #[derive(Debug, Args, Clone, Default)]
 pub struct CheckpointArgs {
-    /// Checkpoint file (default: the output's name with `.ckpt`). When given, the
-    /// checkpoint is also written when the render finishes.
+    /// Checkpoint file (default: for `render` the output's name with `.ckpt`, for
+    /// `resume` the checkpoint resumed). When given, the checkpoint is also written
+    /// when the render finishes.
     #[arg(long, value_name = "PATH")]
     pub checkpoint: Option<PathBuf>,
     /// Write a checkpoint every SECONDS (between batches of passes).
@@ -135,19 +139,10 @@ pub struct ResumeArgs {
     /// Output image, `.png` or `.exr` (default: the original render's output).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-    /// No progress bar or summary on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// Checkpoint file (default: the checkpoint resumed). When given, the
-    /// checkpoint is also written when the render finishes.
-    #[arg(long, value_name = "PATH")]
-    pub checkpoint: Option<PathBuf>,
-    /// Write a checkpoint every SECONDS (between batches of passes).
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
-    pub checkpoint_every: Option<f64>,
+    #[command(flatten)]
+    pub run: RunArgs,
+    #[command(flatten)]
+    pub checkpoint: CheckpointArgs,
     /// Resume even if the scene file changed since the checkpoint was written (the
     /// image then mixes passes of two scenes; the new checkpoint records the new scene).
     #[arg(long)]

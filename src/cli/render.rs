@@ -28,7 +28,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let scene = load_scene(&args.scene, &args.settings.overrides())?;
     let load_time = load_start.elapsed();
     let s = &scene.settings;
-    if !args.quiet {
+    if !args.run.quiet {
         eprintln!(
             "rust-v: {} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}\nrust-v: {}",
             args.scene.display(),
@@ -61,8 +61,8 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         final_checkpoint: args.checkpoint.checkpoint.is_some(),
         every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
         output,
-        threads: args.threads,
-        quiet: args.quiet,
+        threads: args.run.threads,
+        quiet: args.run.quiet,
         budget: args.time.map(Duration::from_secs_f64),
     };
     session.run(&scene, checkpoint, passes.end, &plan)
@@ -72,7 +72,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     let session = Session::start()?;
     let mut ckpt = Checkpoint::read(&args.checkpoint_file)?;
     let path = &args.checkpoint_file;
-    if ckpt.crate_version != env!("CARGO_PKG_VERSION") && !args.quiet {
+    if ckpt.crate_version != env!("CARGO_PKG_VERSION") && !args.run.quiet {
         eprintln!(
             "rust-v: warning: {} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
             path.display(),
@@ -113,7 +113,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     if scene.settings != ckpt.settings {
         return Err(Error::checkpoint(path, format!("its settings {:?} load as {:?}", ckpt.settings, scene.settings)));
     }
-    if !args.quiet {
+    if !args.run.quiet {
         eprintln!(
             "rust-v: resuming {} ({}): passes {}..{} done, rendering to pass {}",
             path.display(),
@@ -126,12 +126,12 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     ckpt.target_end = end.max(done.end);
     ckpt.output = std::path::absolute(&output).map_err(|e| Error::io(&output, e))?;
     let plan = SessionPlan {
-        checkpoint_path: args.checkpoint.clone().unwrap_or_else(|| path.clone()),
-        final_checkpoint: args.checkpoint.is_some(),
-        every: args.checkpoint_every.map(Duration::from_secs_f64),
+        checkpoint_path: args.checkpoint.checkpoint.clone().unwrap_or_else(|| path.clone()),
+        final_checkpoint: args.checkpoint.checkpoint.is_some(),
+        every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
         output,
-        threads: args.threads,
-        quiet: args.quiet,
+        threads: args.run.threads,
+        quiet: args.run.quiet,
         budget: None,
     };
     session.run(&scene, ckpt, end, &plan)

@@ -165,7 +165,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
     let out_dir = args.out.clone().unwrap_or_else(|| PathBuf::from("."));
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     let name = args.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let pool = thread_pool(args.threads)?;
+    let pool = thread_pool(args.run.threads)?;
     let stop = AtomicBool::new(false);
     let base_seed = scene.settings.seed;
     let mut records: Vec<Record> = Vec::new();
@@ -173,7 +173,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
         for k in 0..args.seeds as u64 {
             method.apply(&mut scene);
             scene.settings.seed = base_seed.wrapping_add(k);
-            let quiet = args.quiet;
+            let quiet = args.run.quiet;
             let mut print = |r: &Record| {
                 if !quiet {
                     eprintln!(
@@ -274,7 +274,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
         chart::draw(&file("ratios-spp"), &c, &s)?;
         written.push(file("ratios-spp.png"));
     }
-    if !args.quiet {
+    if !args.run.quiet {
         for p in &written {
             eprintln!("rust-v: wrote {}", p.display());
         }
