@@ -259,7 +259,7 @@ impl Checkpoint {
 
     /// Reads and verifies a checkpoint file.
     pub fn read(path: &Path) -> Result<Checkpoint> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bytes = crate::io::read_input(path)?;
         Checkpoint::decode(&bytes, path)
     }
 

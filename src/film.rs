@@ -138,6 +138,15 @@ impl Film {
         Film { width, height, sums: vec![[0; 3]; width as usize * height as usize], first_pass: 0, passes: 0 }
     }
 
+    /// The most memory a render of a `width` x `height` film takes at once,
+    /// in bytes: the film's sums (48 bytes a pixel), a batch's sample
+    /// buffers (12 bytes a pixel a pass), and a checkpoint being encoded
+    /// (up to 51 bytes a pixel, twice: bincode, then lz4). Renders refuse
+    /// sizes this machine cannot hold before allocating anything.
+    pub fn bytes_needed(width: u32, height: u32) -> u64 {
+        width as u64 * height as u64 * (48 + 12 + 2 * 51)
+    }
+
     /// An empty film whose first pass will be `first_pass` (a render of a
     /// pass range `first_pass..`).
     pub fn starting_at(width: u32, height: u32, first_pass: u32) -> Self {

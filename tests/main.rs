@@ -10,6 +10,7 @@ mod checkpoint;
 mod cli;
 mod furnace;
 mod fuzz;
+mod hostile;
 mod metrics;
 mod scenes;
 mod spectral;

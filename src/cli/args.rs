@@ -175,11 +175,16 @@ fn parse_pass_range(s: &str) -> Result<Range<u32>, Error> {
     Ok(a..b)
 }
 
-/// A positive, finite number of seconds.
+/// The longest time a flag takes: a year, in seconds.
+pub const MAX_SECONDS: f64 = 365.25 * 24.0 * 3600.0;
+
+/// A positive, finite number of seconds, at most [`MAX_SECONDS`].
 fn parse_seconds(s: &str) -> Result<f64, Error> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(Error::Settings(format!("expected a positive number of seconds, got {s:?}"))),
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_SECONDS => Ok(v),
+        _ => Err(Error::Settings(format!(
+            "expected a positive number of seconds up to {MAX_SECONDS} (a year), got {s:?}"
+        ))),
     }
 }
 

@@ -1,4 +1,5 @@
-//! Files in and out: atomic writes, mesh files (OBJ, PLY, optionally
+//! Files in and out: inputs checked to be regular files, outputs checked
+//! up front and written atomically, mesh files (OBJ, PLY, optionally
 //! gzip-compressed), image files, and the crate's one hash.
 //!
 //! Everything here turns bytes on disk into the renderer's types or back,
@@ -6,11 +7,13 @@
 //! line, where the format has lines). Nothing here renders.
 
 mod atomic_file;
+mod files;
 mod hash;
 pub mod image;
 mod mesh_file;
 mod ply;
 
 pub use atomic_file::{temp_path, write_atomic};
+pub use files::{NAME_MAX, check_aliasing, check_output, check_regular, is_snapshot_name, parent_dir, read_input};
 pub use hash::{Fnv1a, fnv1a};
-pub use mesh_file::{MeshData, read_mesh_file};
+pub use mesh_file::{MeshData, parse_mesh, read_mesh_file};

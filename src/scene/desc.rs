@@ -22,7 +22,7 @@
 //! )
 //! ```
 
-use std::collections::BTreeMap;
+use std::collections::BTreeSet;
 
 use serde::Deserialize;
 
@@ -40,14 +40,43 @@ pub struct SceneDesc {
     /// Render settings; each can be overridden on the command line.
     #[serde(default)]
     pub render: SettingsPatch,
-    /// Named materials, referred to by objects.
+    /// Named materials, referred to by objects (a name may appear once).
     #[serde(default)]
-    pub materials: BTreeMap<String, MaterialDesc>,
+    pub materials: Materials,
     /// The objects (shapes with a material or an emission).
     pub objects: Vec<ObjectDesc>,
     /// Lights that are not objects (point lights).
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+}
+
+/// The `materials` map in file order; a name given twice is an error
+/// (`duplicate material "white"`), where a plain map would keep the last.
+#[derive(Debug, Default)]
+pub struct Materials(pub Vec<(String, MaterialDesc)>);
+
+impl<'de> Deserialize<'de> for Materials {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Materials;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a map from material names to materials")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Materials, A::Error> {
+                let mut seen = BTreeSet::new();
+                let mut out = Vec::new();
+                while let Some(name) = map.next_key::<String>()? {
+                    if !seen.insert(name.clone()) {
+                        return Err(serde::de::Error::custom(format!("duplicate material \"{name}\"")));
+                    }
+                    out.push((name, map.next_value()?));
+                }
+                Ok(Materials(out))
+            }
+        }
+        d.deserialize_map(Visit)
+    }
 }
 
 /// A pinhole camera.

@@ -2,6 +2,7 @@
 //! load meshes, and report mistakes with the file, line:column (from the RON
 //! parser) or the field path (for checks after parsing) and what was expected.
 
+use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -13,6 +14,7 @@ use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, Oren
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
+use crate::io::{Fnv1a, fnv1a, parse_mesh, read_input};
 use crate::light::{DiskLight, Light, PointLight, SphereLight};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
@@ -23,43 +25,138 @@ use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Trans
 pub const MAX_MAGNITUDE: f32 = 1e15;
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
-/// precedence over the file's `render` settings.
+/// precedence over the file's `render` settings. The file must be a regular
+/// file of UTF-8 text (a byte-order mark is allowed).
 pub fn load_scene(path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    load_scene_str(&text, path, overrides)
+    let bytes = read_input(path)?;
+    let text = decode_text(&bytes, path)?;
+    load(text, &bytes, path, overrides)
 }
 
 /// Loads a scene from its text; `path` names it in errors and anchors
 /// relative mesh paths.
 pub fn load_scene_str(text: &str, path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
-    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-    let desc: SceneDesc = options.from_str(text).map_err(|e| Error::Scene {
-        path: path.to_path_buf(),
-        position: Some((e.span.start.line, e.span.start.col)),
-        field: String::new(),
-        message: e.code.to_string(),
-    })?;
-    let ctx = Ctx { path, dir: path.parent().map(Path::to_path_buf).unwrap_or_default() };
-    build(&ctx, desc, overrides, fnv1a(text.as_bytes()))
+    load(text, text.as_bytes(), path, overrides)
 }
 
-/// FNV-1a 64-bit hash, for recognising a scene's content in checkpoints.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for &b in bytes {
-        h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+fn load(text: &str, bytes: &[u8], path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
+    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let desc: SceneDesc = options.from_str(text).map_err(|e| {
+        let message = e.code.to_string();
+        let message = match duplicate_key(&message).map(|name| key_positions(text, name)) {
+            Some(at) if at.len() >= 2 => {
+                format!("{message}: defined at {}:{} and again at {}:{}", at[0].0, at[0].1, at[1].0, at[1].1)
+            }
+            _ => message,
+        };
+        Error::Scene {
+            path: path.to_path_buf(),
+            position: Some((e.span.start.line, e.span.start.col)),
+            field: String::new(),
+            message,
+        }
+    })?;
+    let ctx = Ctx { path, dir: path.parent().map(Path::to_path_buf).unwrap_or_default(), inputs: RefCell::default() };
+    let mut scene = build(&ctx, desc, overrides)?;
+    let inputs = ctx.inputs.into_inner();
+    scene.content_hash = content_hash(bytes, &inputs);
+    scene.inputs = inputs.into_iter().map(|i| i.path).collect();
+    Ok(scene)
+}
+
+/// The scene's identity for checkpoints: the FNV-1a hash of its file, and
+/// when it reads other files (meshes, data), of those too, each by its name
+/// as written in the scene and its content's hash. A scene that reads no
+/// other file keeps the hash of its text alone, as checkpoints of format 1
+/// have always recorded it.
+fn content_hash(scene_bytes: &[u8], inputs: &[Input]) -> u64 {
+    if inputs.is_empty() {
+        return fnv1a(scene_bytes);
     }
-    h
+    let mut h = Fnv1a::default();
+    h.write(scene_bytes);
+    for i in inputs {
+        h.write(&[0xff]);
+        h.write(i.name.as_bytes());
+        h.write(&i.hash.to_le_bytes());
+    }
+    h.finish()
+}
+
+/// The scene text from the file's bytes: UTF-8, a leading byte-order mark
+/// skipped; UTF-16 or other bytes are an error at the first bad byte.
+fn decode_text<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str> {
+    let at = |offset: usize, message: String| {
+        let (line, col) = line_col(&bytes[..offset]);
+        Error::Scene { path: path.to_path_buf(), position: Some((line, col)), field: String::new(), message }
+    };
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return Err(at(0, "the file is UTF-16 (it starts with a UTF-16 byte-order mark); expected UTF-8 text".into()));
+    }
+    let body = bytes.strip_prefix(&[0xef, 0xbb, 0xbf]).unwrap_or(bytes);
+    let skipped = bytes.len() - body.len();
+    let text = std::str::from_utf8(body).map_err(|e| {
+        let offset = skipped + e.valid_up_to();
+        at(offset, format!("byte 0x{:02x} is not UTF-8; expected UTF-8 text", bytes[offset]))
+    })?;
+    if let Some(offset) = text.find('\0') {
+        return Err(at(skipped + offset, "a NUL byte (UTF-16 or binary data?); expected UTF-8 text".into()));
+    }
+    Ok(text)
+}
+
+/// 1-based line and column (in characters) just after `before`.
+fn line_col(before: &[u8]) -> (usize, usize) {
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let last = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let col = String::from_utf8_lossy(&before[last..]).chars().count() + 1;
+    (line, col)
+}
+
+/// The name in a duplicate-key error of [`super::desc`].
+fn duplicate_key(message: &str) -> Option<&str> {
+    message.strip_prefix("duplicate material \"")?.split('"').next()
+}
+
+/// Where `"name"` stands as a map key (followed by `:`) in the text.
+fn key_positions(text: &str, name: &str) -> Vec<(usize, usize)> {
+    let quoted = format!("\"{name}\"");
+    text.match_indices(&quoted)
+        .filter(|(i, _)| text[i + quoted.len()..].trim_start().starts_with(':'))
+        .map(|(i, _)| line_col(&text.as_bytes()[..i]))
+        .collect()
+}
+
+/// A file the scene reads besides itself.
+struct Input {
+    /// The path as written in the scene.
+    name: String,
+    /// The path it resolves to.
+    path: PathBuf,
+    /// FNV-1a of its content.
+    hash: u64,
 }
 
 struct Ctx<'a> {
     path: &'a Path,
     dir: PathBuf,
+    /// Every file read so far, in order (for the scene's identity).
+    inputs: RefCell<Vec<Input>>,
 }
 
 impl Ctx<'_> {
     fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
         Error::scene_field(self.path, field, message)
+    }
+
+    /// Reads a file the scene names (`rel`, relative to the scene file) for
+    /// field `field`, and records it in the scene's identity. Only regular
+    /// files are read.
+    fn read_input(&self, field: &str, rel: &str) -> Result<(PathBuf, Vec<u8>)> {
+        let path = self.dir.join(rel);
+        let bytes = read_input(&path).map_err(|e| self.err(field, e.to_string()))?;
+        self.inputs.borrow_mut().push(Input { name: rel.to_string(), path: path.clone(), hash: fnv1a(&bytes) });
+        Ok((path, bytes))
     }
 
     fn positive(&self, field: &str, v: f32) -> Result<f32> {
@@ -224,24 +321,34 @@ impl Ctx<'_> {
                 };
                 let transform = Transform {
                     scale,
-                    rotate_deg: rotate_deg.map(Vec3::from).unwrap_or(Vec3::ZERO),
-                    translate: translate.map(Vec3::from).unwrap_or(Vec3::ZERO),
+                    rotate_deg: match rotate_deg {
+                        Some(r) => self.vec(&f("rotate_deg"), *r)?,
+                        None => Vec3::ZERO,
+                    },
+                    translate: match translate {
+                        Some(t) => self.vec(&f("translate"), *t)?,
+                        None => Vec3::ZERO,
+                    },
                 };
-                let file = self.dir.join(path);
-                let mesh = Mesh::load(&file, &transform).map_err(|e| self.err(f("path"), e.to_string()))?;
+                let (file, bytes) = self.read_input(&f("path"), path)?;
+                let data = parse_mesh(bytes, &file).map_err(|e| self.err(f("path"), e.to_string()))?;
+                let mesh = Mesh::from_data(data, &file, &transform).map_err(|e| match e {
+                    Error::Setting { name, message } => self.err(f(name), message),
+                    e => self.err(f("path"), e.to_string()),
+                })?;
                 Shape::Mesh(Box::new(mesh))
             }
         })
     }
 }
 
-fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash: u64) -> Result<Scene> {
+fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Scene> {
     let settings = settings(ctx, &desc.render, overrides)?;
 
     // Materials by name; index 0 is the implicit black material of lights.
     let mut materials = vec![Bxdf::Black];
     let mut by_name = BTreeMap::new();
-    for (name, m) in &desc.materials {
+    for (name, m) in &desc.materials.0 {
         by_name.insert(name.as_str(), materials.len() as u32);
         materials.push(ctx.material(&format!("materials.\"{name}\""), m)?);
     }
@@ -302,7 +409,7 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
         return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {}", c.fov_deg)));
     }
     let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height);
-    Ok(Scene::new(objects, materials, lights, camera, settings, content_hash))
+    Ok(Scene::new(objects, materials, lights, camera, settings, 0))
 }
 
 /// Combines defaults, the file's `render` block and the command line, and checks the result.

@@ -68,8 +68,12 @@ pub struct Scene {
     /// Indices of unbounded objects (planes).
     unbounded: Vec<u32>,
     bvh: Option<Bvh>,
-    /// A hash of the scene file's content (for checkpoints).
+    /// The identity of the scene file and every file it reads (for
+    /// checkpoints: resume and merge refuse other inputs).
     pub content_hash: u64,
+    /// Every file the scene reads besides itself (meshes, data files), as
+    /// resolved paths: no output may overwrite one.
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 impl Scene {
@@ -127,6 +131,7 @@ impl Scene {
             unbounded,
             bvh,
             content_hash,
+            inputs: Vec::new(),
         }
     }
 
