@@ -445,16 +445,66 @@ const CLI_CASES: u64 = 48;
 /// Values a flag is given: the edges of every numeric type, signs, NaN,
 /// infinities, empty and malformed text, paths that are not files.
 const FLAG_VALUES: &[&str] = &[
-    "0", "1", "2", "3", "8", "16", "-1", "40000", "4294967295", "4294967296", "18446744073709551616", "1e300",
-    "-1e300", "nan", "NaN", "inf", "-inf", "0.5", "1e-300", "", " ", "x", "0..2", "2..1", "3..3", "a..b",
-    "0..4294967296", "auto", "path", "whitted", "spectral", "hero", "random", "rgb", "/dev/null", "/proc",
-    "/nonexistent/out.png", ".", "out.png", "out.exr", "out.ckpt", "é.png",
+    "0",
+    "1",
+    "2",
+    "3",
+    "8",
+    "16",
+    "-1",
+    "40000",
+    "4294967295",
+    "4294967296",
+    "18446744073709551616",
+    "1e300",
+    "-1e300",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "0.5",
+    "1e-300",
+    "",
+    " ",
+    "x",
+    "0..2",
+    "2..1",
+    "3..3",
+    "a..b",
+    "0..4294967296",
+    "auto",
+    "path",
+    "whitted",
+    "spectral",
+    "hero",
+    "random",
+    "rgb",
+    "/dev/null",
+    "/proc",
+    "/nonexistent/out.png",
+    ".",
+    "out.png",
+    "out.exr",
+    "out.ckpt",
+    "é.png",
 ];
 
 /// Flags with values, per subcommand; `--time 0.3` bounds every render.
 const RENDER_FLAGS: &[&str] = &[
-    "--spp", "--seed", "--width", "--height", "--max-bounces", "--integrator", "--wavelengths", "--packet-size",
-    "--threads", "--passes", "--checkpoint", "--checkpoint-every", "--time", "-o",
+    "--spp",
+    "--seed",
+    "--width",
+    "--height",
+    "--max-bounces",
+    "--integrator",
+    "--wavelengths",
+    "--packet-size",
+    "--threads",
+    "--passes",
+    "--checkpoint",
+    "--checkpoint-every",
+    "--time",
+    "-o",
 ];
 const RESUME_FLAGS: &[&str] = &["--spp", "--threads", "--checkpoint", "--checkpoint-every", "-o"];
 const SWITCHES: &[&str] = &["-q", "--quiet", "--force", "--json", "--bogus", "-"];
@@ -483,7 +533,7 @@ fn fuzz_command_line() {
         .status()
         .unwrap();
     assert!(ok.success());
-    let mut rng = Pcg32::new(0x5eed_c11, 0xda3e_39cb_94b9_5bdb);
+    let mut rng = Pcg32::new(0x05ee_dc11, 0xda3e_39cb_94b9_5bdb);
     let (mut codes, mut panics) = ([0u32; 3], Vec::new());
     for case in 0..n {
         let pick = |rng: &mut Pcg32, v: &[&'static str]| v[below(rng, v.len())];

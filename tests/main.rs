@@ -11,6 +11,7 @@ mod cli;
 mod furnace;
 mod fuzz;
 mod hostile;
+mod lights;
 mod metrics;
 mod scenes;
 mod spectral;

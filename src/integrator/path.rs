@@ -105,7 +105,7 @@ impl PathTracer {
                     let weight = if w.prev.delta {
                         1.0
                     } else {
-                        let pdf_light = scene.light_pmf[index as usize] * light.pdf_li(w.prev.p, ray.dir, hit.p);
+                        let pdf_light = scene.light_pmf[index as usize] * light.pdf_li(w.prev.p, ray.dir, hit.p, hit.n);
                         power_heuristic(w.prev.pdf_bsdf, pdf_light)
                     };
                     l += w.beta * lambdas.sample(light.spectrum()) * (scale * weight);

@@ -258,7 +258,8 @@ pub struct ObjectDesc {
     /// The name of a material in `materials` (default: black, for lights).
     #[serde(default)]
     pub material: Option<String>,
-    /// Emitted radiance, making the object an area light (spheres and disks).
+    /// Emitted radiance, making the object an area light (spheres, disks,
+    /// quads, cuboids and meshes).
     #[serde(default)]
     pub emission: Option<SpectrumDesc>,
     /// Whether the emission leaves both sides of the surface (default false:
@@ -277,5 +278,36 @@ pub enum LightDesc {
         position: V3,
         /// Radiant intensity.
         intensity: SpectrumDesc,
+    },
+    /// A point light limited to a cone with a smooth falloff at its edge.
+    Spot {
+        /// Position.
+        position: V3,
+        /// The point the cone's axis goes through.
+        look_at: V3,
+        /// The cone's half-angle in degrees (0 to 90).
+        cone_deg: f32,
+        /// The width of the smooth edge inside the cone, in degrees (0 to `cone_deg`).
+        falloff_deg: f32,
+        /// Radiant intensity on the axis.
+        intensity: SpectrumDesc,
+    },
+    /// Parallel light from one direction everywhere (the sun).
+    Distant {
+        /// The direction the light travels in.
+        direction: V3,
+        /// Irradiance on a surface facing it.
+        irradiance: SpectrumDesc,
+    },
+    /// A collimated beam of parallel light from a disk.
+    Beam {
+        /// The centre of the emitting disk.
+        origin: V3,
+        /// The direction the light travels in (the disk faces it).
+        direction: V3,
+        /// The beam's radius.
+        radius: f32,
+        /// Irradiance across the beam.
+        irradiance: SpectrumDesc,
     },
 }

@@ -15,7 +15,7 @@ use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
 use crate::io::{Fnv1a, fnv1a, parse_mesh, read_input};
-use crate::light::{DiskLight, Light, PointLight, SphereLight};
+use crate::light::{AreaLight, BeamLight, DiskLight, DistantLight, Light, PointLight, SphereLight, SpotLight};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
 
@@ -373,10 +373,23 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Sc
             None => None,
             Some(e) => {
                 let radiance = ctx.spectrum(&format!("{field}.emission"), e)?;
+                let two = o.two_sided;
+                let flat = |l: Option<AreaLight>| {
+                    l.map(Light::Area)
+                        .ok_or_else(|| ctx.err(format!("{field}.shape"), "an emitter needs a non-zero area"))
+                };
                 let l = match &shape {
-                    Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided: o.two_sided }),
-                    Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided: o.two_sided }),
-                    _ => return Err(ctx.err(format!("{field}.emission"), "only Sphere and Disk shapes can emit")),
+                    Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided: two }),
+                    Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided: two }),
+                    Shape::Quad(q) => flat(AreaLight::quad(q, radiance, two))?,
+                    Shape::Cuboid(c) => flat(AreaLight::cuboid(c, radiance, two))?,
+                    Shape::Mesh(m) => flat(AreaLight::mesh(m, radiance, two))?,
+                    Shape::Plane(_) | Shape::Bubble(_) => {
+                        return Err(ctx.err(
+                            format!("{field}.emission"),
+                            "a Plane (infinite) or Bubble cannot emit; expected a Sphere, Disk, Quad, Cuboid or Mesh",
+                        ));
+                    }
                 };
                 lights.push(l);
                 Some(lights.len() as u32 - 1)
@@ -389,6 +402,36 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Sc
             LightDesc::Point { position, intensity } => lights.push(Light::Point(PointLight {
                 position: ctx.vec(&format!("lights[{i}].position"), *position)?,
                 intensity: ctx.spectrum(&format!("lights[{i}].intensity"), intensity)?,
+            })),
+            LightDesc::Spot { position, look_at, cone_deg, falloff_deg, intensity } => {
+                let f = |name: &str| format!("lights[{i}].{name}");
+                let position = ctx.vec(&f("position"), *position)?;
+                let target = ctx.vec(&f("look_at"), *look_at)?;
+                let axis = (target - position)
+                    .try_normalize()
+                    .ok_or_else(|| ctx.err(f("look_at"), "must differ from position"))?;
+                if !(cone_deg.is_finite() && *cone_deg > 0.0 && *cone_deg <= 90.0) {
+                    return Err(ctx.err(f("cone_deg"), format!("expected degrees in (0, 90], found {cone_deg}")));
+                }
+                if !(falloff_deg.is_finite() && (0.0..=*cone_deg).contains(falloff_deg)) {
+                    return Err(ctx.err(
+                        f("falloff_deg"),
+                        format!("expected degrees from 0 to cone_deg ({cone_deg}), found {falloff_deg}"),
+                    ));
+                }
+                let intensity = ctx.spectrum(&f("intensity"), intensity)?;
+                lights.push(Light::Spot(SpotLight::new(position, axis, *cone_deg, *falloff_deg, intensity)));
+            }
+            LightDesc::Distant { direction, irradiance } => lights.push(Light::Distant(DistantLight {
+                direction: ctx.direction(&format!("lights[{i}].direction"), *direction)?,
+                irradiance: ctx.spectrum(&format!("lights[{i}].irradiance"), irradiance)?,
+                scene_radius: 1.0,
+            })),
+            LightDesc::Beam { origin, direction, radius, irradiance } => lights.push(Light::Beam(BeamLight {
+                origin: ctx.vec(&format!("lights[{i}].origin"), *origin)?,
+                direction: ctx.direction(&format!("lights[{i}].direction"), *direction)?,
+                radius: ctx.positive(&format!("lights[{i}].radius"), *radius)?,
+                irradiance: ctx.spectrum(&format!("lights[{i}].irradiance"), irradiance)?,
             })),
         }
     }
