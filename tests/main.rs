@@ -12,5 +12,6 @@ mod furnace;
 mod fuzz;
 mod metrics;
 mod scenes;
+mod spectra;
 mod spectral;
 mod stability;
