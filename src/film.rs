@@ -32,14 +32,15 @@
 //!   out-of-gamut values become 0; values above 1 become 1: no tone mapping,
 //!   no exposure) and encoded with the sRGB transfer curve.
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
-//!   unclamped, for measurements.
+//!   unclamped, for measurements; or Rec. 2020, ACEScg or XYZ when the film's
+//!   [`ColorSpace`] says so (`--color-space`).
 
 use std::ops::Range;
 use std::path::Path;
 
-use crate::color::{Xyz, xyz_to_linear_srgb_f64};
+use crate::color::{ColorSpace, Xyz, xyz_to_linear_srgb_f64};
 use crate::error::{Error, Result};
-use crate::io::image::write_linear_srgb;
+use crate::io::image::{is_exr, write_exr_in, write_linear_srgb};
 
 /// Fractional bits of the fixed-point sums.
 pub const FRAC_BITS: u32 = 64;
@@ -130,12 +131,21 @@ pub struct Film {
     first_pass: u32,
     /// Passes (samples per pixel) summed so far.
     passes: u32,
+    /// The colour space EXR output is written in (an output choice: not stored in checkpoints).
+    color_space: ColorSpace,
 }
 
 impl Film {
     /// An empty film (its pass range starts where the first render starts).
     pub fn new(width: u32, height: u32) -> Self {
-        Film { width, height, sums: vec![[0; 3]; width as usize * height as usize], first_pass: 0, passes: 0 }
+        Film {
+            width,
+            height,
+            sums: vec![[0; 3]; width as usize * height as usize],
+            first_pass: 0,
+            passes: 0,
+            color_space: ColorSpace::Srgb,
+        }
     }
 
     /// An empty film whose first pass will be `first_pass` (a render of a
@@ -160,7 +170,17 @@ impl Film {
         if let Some(i) = sums.iter().position(|s| s.iter().any(|v| v.unsigned_abs() > bound.unsigned_abs())) {
             return Err(Error::Mismatch(format!("pixel {i} holds a sum out of range for {n} passes")));
         }
-        Ok(Film { width, height, sums, first_pass: passes.start, passes: n })
+        Ok(Film { width, height, sums, first_pass: passes.start, passes: n, color_space: ColorSpace::Srgb })
+    }
+
+    /// Sets the colour space of EXR output (PNG output is always sRGB).
+    pub fn set_color_space(&mut self, space: ColorSpace) {
+        self.color_space = space;
+    }
+
+    /// The colour space of EXR output.
+    pub fn color_space(&self) -> ColorSpace {
+        self.color_space
     }
 
     /// Width in pixels.
@@ -284,9 +304,13 @@ impl Film {
         self.mean_xyz().into_iter().map(xyz_to_linear_srgb_f64).collect()
     }
 
-    /// Writes the image: linear EXR if `path` ends in `.exr`, else 16-bit sRGB PNG
-    /// ([`crate::io::image::write_linear_srgb`]), atomically.
+    /// Writes the image: linear EXR if `path` ends in `.exr` (in the film's colour space), else
+    /// 16-bit sRGB PNG ([`crate::io::image::write_linear_srgb`]), atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
+        if is_exr(path) && self.color_space != ColorSpace::Srgb {
+            let pixels: Vec<[f64; 3]> = self.mean_xyz().into_iter().map(|p| self.color_space.from_xyz(p)).collect();
+            return write_exr_in(path, self.width, self.height, &pixels, self.color_space);
+        }
         write_linear_srgb(path, self.width, self.height, &self.linear_srgb())
     }
 }

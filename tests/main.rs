@@ -11,6 +11,7 @@ mod cli;
 mod furnace;
 mod fuzz;
 mod metrics;
+mod output;
 mod scenes;
 mod spectra;
 mod spectral;

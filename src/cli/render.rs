@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use rust_v::color::ColorSpace;
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
 use rust_v::error::{Error, Result};
 use rust_v::film::Film;
@@ -24,6 +25,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let session = Session::start()?;
     let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
     check_output_extension(&output)?;
+    check_color_space(&output, args.color_space)?;
     let load_start = Instant::now();
     let scene = load_scene(&args.scene, &args.settings.overrides())?;
     let load_time = load_start.elapsed();
@@ -47,7 +49,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
-    let checkpoint = Checkpoint {
+    let mut checkpoint = Checkpoint {
         crate_version: env!("CARGO_PKG_VERSION").into(),
         scene_path,
         content_hash: scene.content_hash,
@@ -56,6 +58,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         output: std::path::absolute(&output).map_err(|e| Error::io(&output, e))?,
         film: Film::starting_at(s.width, s.height, passes.start),
     };
+    checkpoint.film.set_color_space(args.color_space);
     let plan = SessionPlan {
         checkpoint_path: args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output)),
         final_checkpoint: args.checkpoint.checkpoint.is_some(),
@@ -90,6 +93,8 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     }
     let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
     check_output_extension(&output)?;
+    check_color_space(&output, args.color_space)?;
+    ckpt.film.set_color_space(args.color_space);
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
     if scene.content_hash != ckpt.content_hash && args.force {
@@ -147,7 +152,11 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     for p in &args.parts {
         parts.push((p.clone(), Checkpoint::read(p)?));
     }
-    let merged = merge(parts)?;
+    let mut merged = merge(parts)?;
+    if !is_ckpt {
+        check_color_space(&args.output, args.color_space)?;
+        merged.film.set_color_space(args.color_space);
+    }
     if is_ckpt {
         merged.write(&args.output)?;
     } else {
@@ -162,6 +171,18 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
             r.end,
             args.output.display()
         );
+    }
+    Ok(())
+}
+
+/// A colour space other than sRGB needs an EXR output.
+fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
+    if space != ColorSpace::Srgb && !rust_v::io::image::is_exr(output) {
+        return Err(Error::Settings(format!(
+            "--color-space {} needs an .exr output; {} is a PNG, always sRGB",
+            space.name(),
+            output.display()
+        )));
     }
     Ok(())
 }

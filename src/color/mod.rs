@@ -5,11 +5,13 @@
 //! exact colour integral of the interpolated spectrum ([`color_weights`], `cie.rs`), and to sRGB with the
 //! same matrix as Mitsuba 3 ([`XYZ_TO_LINEAR_SRGB`], `rgb.rs`). `named.rs` holds the spectra a
 //! scene file can refer to ([`color_checker`], [`d65`], [`blackbody`]); `uplift.rs` turns linear
-//! sRGB into spectra ([`rgb_reflectance`], [`rgb_emission`]).
+//! sRGB into spectra ([`rgb_reflectance`], [`rgb_emission`]); `space.rs` holds the EXR output spaces
+//! ([`ColorSpace`]).
 
 mod cie;
 mod named;
 mod rgb;
+mod space;
 mod spectrum;
 mod uplift;
 
@@ -18,5 +20,6 @@ pub use named::{COLOR_CHECKER_NAMES, blackbody, color_checker, d65, equal_energy
 pub use rgb::{
     LINEAR_SRGB_TO_XYZ, LinearSrgb, Srgb, XYZ_TO_LINEAR_SRGB, Xyz, srgb_eotf, srgb_oetf, xyz_to_linear_srgb_f64,
 };
+pub use space::ColorSpace;
 pub use uplift::{reflectance_to_linear_srgb, rgb_emission, rgb_reflectance};
 pub use spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Sampled, Spectrum, bin_lambda_nm};

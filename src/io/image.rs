@@ -6,13 +6,14 @@
 //!   out-of-gamut values become 0; values above 1 become 1: no tone mapping,
 //!   no exposure) and encoded with the sRGB transfer curve ([`encode_u16`]).
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
-//!   unclamped, for measurements.
+//!   unclamped, for measurements; or, with `--color-space`, Rec. 2020, ACEScg or XYZ with a
+//!   `chromaticities` attribute ([`write_exr_in`]).
 
 use std::io::Cursor;
 use std::path::Path;
 
 use super::write_atomic;
-use crate::color::srgb_oetf;
+use crate::color::{ColorSpace, srgb_oetf};
 use crate::error::{Error, Result};
 
 /// True when `path` names an EXR file (by its extension, any case).
@@ -41,6 +42,34 @@ pub fn write_linear_srgb(path: &Path, width: u32, height: u32, rgb: &[[f64; 3]])
             .write_to(&mut bytes, image::ImageFormat::Png)
             .map_err(image_error)?;
     }
+    write_atomic(path, &bytes.into_inner())
+}
+
+/// Writes `width` x `height` pixels (row-major, already in `space`) as a 32-bit float EXR whose
+/// `chromaticities` attribute names the space, atomically. XYZ gets channels X, Y, Z (the
+/// OpenEXR convention, as Mitsuba writes it); the RGB spaces R, G, B.
+pub fn write_exr_in(path: &Path, width: u32, height: u32, pixels: &[[f64; 3]], space: ColorSpace) -> Result<()> {
+    use exr::meta::attribute::Chromaticities;
+    use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, Vec2, WritableImage};
+    let bad = |message: String| Error::Image { path: path.to_path_buf(), message };
+    if pixels.len() != width as usize * height as usize {
+        return Err(bad("buffer size does not match".into()));
+    }
+    let names = space.channels();
+    let channels: Vec<AnyChannel<FlatSamples>> = (0..3)
+        .map(|c| AnyChannel::new(names[c], FlatSamples::F32(pixels.iter().map(|p| p[c] as f32).collect())))
+        .collect();
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels.into()),
+    );
+    let mut image = exr::image::Image::from_layer(layer);
+    let xy = space.chromaticities().map(|[x, y]| Vec2(x as f32, y as f32));
+    image.attributes.chromaticities = Some(Chromaticities { red: xy[0], green: xy[1], blue: xy[2], white: xy[3] });
+    let mut bytes = Cursor::new(Vec::new());
+    image.write().non_parallel().to_buffered(&mut bytes).map_err(|e| bad(e.to_string()))?;
     write_atomic(path, &bytes.into_inner())
 }
 
