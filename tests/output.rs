@@ -69,8 +69,7 @@ fn color_spaces_convert_the_same_render() {
         }
         for (p, s) in px.iter().zip(&srgb) {
             let m = LINEAR_SRGB_TO_XYZ;
-            let xyz: [f64; 3] =
-                std::array::from_fn(|i| (0..3).map(|j| m[i][j] as f64 * s[j]).sum());
+            let xyz: [f64; 3] = std::array::from_fn(|i| (0..3).map(|j| m[i][j] as f64 * s[j]).sum());
             let want = space.from_xyz(xyz);
             for k in 0..3 {
                 // f32 storage of both files plus the 6-decimal sRGB matrices (inverse to 1e-5).

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use rust_v::color::ColorSpace;
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
+use rust_v::color::ColorSpace;
 use rust_v::error::{Error, Result};
 use rust_v::film::Film;
 use rust_v::scene::load_scene;

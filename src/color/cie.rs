@@ -243,11 +243,8 @@ mod tests {
     fn integral_1nm(s: &Spectrum) -> [f64; 3] {
         let mut acc = [0.0f64; 3];
         let mut y = 0.0f64;
-        let rows: Vec<Vec<f64>> = CMF_1NM_CSV
-            .lines()
-            .skip(1)
-            .map(|l| l.split(',').map(|c| c.parse::<f64>().unwrap()).collect())
-            .collect();
+        let rows: Vec<Vec<f64>> =
+            CMF_1NM_CSV.lines().skip(1).map(|l| l.split(',').map(|c| c.parse::<f64>().unwrap()).collect()).collect();
         for (i, r) in rows.iter().enumerate() {
             let end = if i == 0 || i == rows.len() - 1 { 0.5 } else { 1.0 };
             let pos = ((r[0] - 380.0) / 10.0).clamp(0.0, 35.0);

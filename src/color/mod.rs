@@ -21,5 +21,5 @@ pub use rgb::{
     LINEAR_SRGB_TO_XYZ, LinearSrgb, Srgb, XYZ_TO_LINEAR_SRGB, Xyz, srgb_eotf, srgb_oetf, xyz_to_linear_srgb_f64,
 };
 pub use space::ColorSpace;
-pub use uplift::{reflectance_to_linear_srgb, rgb_emission, rgb_reflectance};
 pub use spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Sampled, Spectrum, bin_lambda_nm};
+pub use uplift::{reflectance_to_linear_srgb, rgb_emission, rgb_reflectance};

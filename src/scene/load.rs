@@ -111,10 +111,16 @@ impl Ctx<'_> {
         }
         for (k, w) in points.iter().enumerate() {
             if !(w.0.is_finite() && w.1.is_finite() && w.0 > 0.0) {
-                return Err(self.err(format!("{field}[{k}]"), format!("expected a positive wavelength in nm and a finite value, found {w:?}")));
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("expected a positive wavelength in nm and a finite value, found {w:?}"),
+                ));
             }
             if k > 0 && w.0 <= points[k - 1].0 {
-                return Err(self.err(format!("{field}[{k}]"), format!("wavelengths must increase: {} nm follows {} nm", w.0, points[k - 1].0)));
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("wavelengths must increase: {} nm follows {} nm", w.0, points[k - 1].0),
+                ));
             }
         }
         Ok(Spectrum::from_table(points))
@@ -171,7 +177,9 @@ impl Ctx<'_> {
                 let rgb = [*r, *g, *b];
                 let limit = if role == Role::Reflectance { 1.0 } else { MAX_MAGNITUDE };
                 if !rgb.iter().all(|v| v.is_finite() && (0.0..=limit).contains(v)) {
-                    return Err(self.err(field, format!("expected linear sRGB components in [0, {limit}], found {rgb:?}")));
+                    return Err(
+                        self.err(field, format!("expected linear sRGB components in [0, {limit}], found {rgb:?}"))
+                    );
                 }
                 match role {
                     Role::Reflectance => color::rgb_reflectance(rgb),
