@@ -137,6 +137,46 @@ impl<const N: usize> Lambdas<N> {
     }
 }
 
+impl<const N: usize> Lambdas<N> {
+    /// The per-bin radiance estimate of a packet of radiance values: each wavelength's value
+    /// times the packet weight, in its bin (bins outside the packet are 0), so that
+    /// `bins(l).to_xyz() == xyz(l)` up to rounding. The spectral film sums these. The RGB mode
+    /// has no bins: it gives zero (the command line refuses `--spectral` with it).
+    pub fn bins(&self, l: &Sampled<N>) -> Spectrum {
+        let mut out = Spectrum::ZERO;
+        if self.readout == Readout::Spectral {
+            for i in 0..N {
+                // Packets of sampled bins always sit on integer positions.
+                out.0[(self.pos[i] as usize).min(N_BINS - 1)] += l.0[i] * self.weight;
+            }
+        }
+        out
+    }
+}
+
+/// What an integrator returns for one camera sample: its colour ([`Xyz`]) or, for spectral
+/// output, its per-bin radiance estimate ([`Spectrum`], whose colour integral is that colour).
+/// The integrators are generic over it, so the colour-only path pays nothing for spectral
+/// output.
+pub(crate) trait Contribution: Copy + Default + core::ops::AddAssign + Send + Sync + 'static {
+    /// The contribution of a packet's radiance values.
+    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self;
+}
+
+impl Contribution for Xyz {
+    #[inline]
+    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
+        lambdas.xyz(l)
+    }
+}
+
+impl Contribution for Spectrum {
+    #[inline]
+    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
+        lambdas.bins(l)
+    }
+}
+
 /// Which linear sRGB channel (0 = r, 1 = g, 2 = b) an RGB-mode wavelength feeds.
 fn rgb_channel(lambda_nm: f32) -> usize {
     if lambda_nm < 500.0 {

@@ -1,4 +1,5 @@
-//! Image output: `--color-space` for EXR, checked against the sRGB render of the same scene.
+//! Image output: `--color-space` and `--spectral` for EXR, checked against the sRGB render of the
+//! same scene and against the colour weights.
 
 use std::path::Path;
 
@@ -90,4 +91,63 @@ fn color_space_needs_an_exr() {
     let o = render(&dir.join("x.exr"), &["--color-space", "p3"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("rec2020"));
+}
+
+/// `--spectral`: the EXR holds the 36 bins as channels `S0.380,000000nm` ... `S0.730,000000nm`
+/// (Fichet et al. 2021) with the layout's attributes, and on every pixel the bins weighted by
+/// the colour weights W_b give the XYZ channels of the same file to f32 rounding (the film sums
+/// both exactly; XYZ is the colour integral of each sample's bins). On the N-SF11 glass spheres
+/// (`auto` splits into single wavelengths in them), and with `spectral` hero packets.
+#[test]
+fn spectral_exr_bins_reproduce_the_xyz() {
+    use exr::prelude::*;
+    let dir = temp_dir("spectral-exr");
+    let w = rust_v::color::color_weights();
+    for extra in [&["--integrator", "auto"][..], &["--integrator", "spectral", "--wavelengths", "hero"][..]] {
+        let path = dir.join("s.exr");
+        let scene = root().join("scenes/spheres.ron");
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", path.to_str().unwrap(), "--quiet"];
+        args.extend_from_slice(&[
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--spp",
+            "4",
+            "--spectral",
+            "--color-space",
+            "xyz",
+        ]);
+        args.extend_from_slice(extra);
+        let o = rust_v(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let image = read_all_flat_layers_from_file(&path).expect("EXR reads");
+        let layer = &image.layer_data[0];
+        let attr = |k: &str| layer.attributes.other.get(&Text::from(k)).cloned();
+        assert_eq!(attr("spectralLayoutVersion"), Some(AttributeValue::Text(Text::from("1.0"))));
+        let channel = |name: &str| -> Vec<f32> {
+            let c = layer.channel_data.list.iter().find(|c| c.name == *name);
+            c.unwrap_or_else(|| panic!("no channel {name}")).sample_data.values_as_f32().collect()
+        };
+        let xyz = [channel("X"), channel("Y"), channel("Z")];
+        let bins: Vec<Vec<f32>> = (0..36).map(|b| channel(&format!("S0.{},000000nm", 380 + 10 * b))).collect();
+        assert_eq!(layer.channel_data.list.len(), 39);
+        let mut lit = 0;
+        for p in 0..xyz[0].len() {
+            let scale: f64 = (0..36).map(|b| bins[b][p].abs() as f64).sum::<f64>().max(1e-3);
+            for c in 0..3 {
+                let want: f64 = (0..36).map(|b| w[b][c] as f64 * bins[b][p] as f64).sum();
+                assert!(
+                    (xyz[c][p] as f64 - want).abs() < 1e-5 * scale,
+                    "{extra:?} pixel {p} channel {c}: {} vs {want}",
+                    xyz[c][p]
+                );
+            }
+            lit += (xyz[1][p] > 0.0) as usize;
+        }
+        assert!(lit > 10, "{extra:?}: the box is lit ({lit} lit pixels)");
+    }
+    // --spectral needs an EXR.
+    let o = rust_v(&["render", "scenes/prism.ron", "-o", dir.join("x.png").to_str().unwrap(), "--spectral", "--quiet"]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--spectral needs an .exr"));
 }

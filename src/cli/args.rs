@@ -97,6 +97,11 @@ pub struct RenderArgs {
     /// from D65) or xyz. PNG output is always sRGB.
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
+    /// With an .exr output: also write the 36 spectral bins (380-730 nm) as channels in the
+    /// layout of Fichet et al. 2021, summed exactly like the colour (the checkpoint then holds
+    /// them too, so resumed and merged renders stay bit-identical).
+    #[arg(long)]
+    pub spectral: bool,
     #[command(flatten)]
     pub settings: SettingsArgs,
     /// Worker threads (default: all cores).

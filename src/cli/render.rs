@@ -26,10 +26,19 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
     check_output_extension(&output)?;
     check_color_space(&output, args.color_space)?;
+    if args.spectral && !rust_v::io::image::is_exr(&output) {
+        return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", output.display())));
+    }
     let load_start = Instant::now();
     let scene = load_scene(&args.scene, &args.settings.overrides())?;
     let load_time = load_start.elapsed();
     let s = &scene.settings;
+    if args.spectral
+        && s.integrator == rust_v::settings::IntegratorKind::Spectral
+        && s.wavelengths == rust_v::settings::WavelengthsKind::Rgb
+    {
+        return Err(Error::Settings("--spectral: the RGB mode (--wavelengths rgb) has no spectral bins".into()));
+    }
     if !args.quiet {
         eprintln!(
             "rust-v: {} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}\nrust-v: {}",
@@ -56,7 +65,11 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         settings: scene.settings.clone(),
         target_end: passes.end,
         output: std::path::absolute(&output).map_err(|e| Error::io(&output, e))?,
-        film: Film::starting_at(s.width, s.height, passes.start),
+        film: if args.spectral {
+            Film::new_spectral(s.width, s.height, passes.start)
+        } else {
+            Film::starting_at(s.width, s.height, passes.start)
+        },
     };
     checkpoint.film.set_color_space(args.color_space);
     let plan = SessionPlan {

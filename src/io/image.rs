@@ -49,19 +49,52 @@ pub fn write_linear_srgb(path: &Path, width: u32, height: u32, rgb: &[[f64; 3]])
 /// `chromaticities` attribute names the space, atomically. XYZ gets channels X, Y, Z (the
 /// OpenEXR convention, as Mitsuba writes it); the RGB spaces R, G, B.
 pub fn write_exr_in(path: &Path, width: u32, height: u32, pixels: &[[f64; 3]], space: ColorSpace) -> Result<()> {
-    use exr::meta::attribute::Chromaticities;
+    write_exr(path, width, height, pixels, space, None)
+}
+
+/// The channel name of spectral bin `lambda_nm` in the layout of Fichet et al. 2021 ("An
+/// OpenEXR Layout for Spectral Images", JCGT 10(3)): emissive Stokes component 0, the
+/// wavelength with a comma as the decimal separator, then the unit: `S0.380,000000nm`.
+pub fn spectral_channel_name(lambda_nm: f32) -> String {
+    format!("S0.{:.6}nm", lambda_nm).replace('.', ",").replacen(',', ".", 1)
+}
+
+/// Writes an EXR like [`write_exr_in`] plus, when `spectral` is given (per pixel, the mean
+/// radiance of each bin at `wavelengths_nm`), one float channel per bin named as Fichet et al.
+/// 2021 specify ([`spectral_channel_name`]), with their `spectralLayoutVersion` and
+/// `emissiveUnits` attributes.
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f64; 3]],
+    space: ColorSpace,
+    spectral: Option<(&[f32], &[Vec<f32>])>,
+) -> Result<()> {
+    use exr::meta::attribute::{AttributeValue, Chromaticities, Text};
     use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, Vec2, WritableImage};
     let bad = |message: String| Error::Image { path: path.to_path_buf(), message };
     if pixels.len() != width as usize * height as usize {
         return Err(bad("buffer size does not match".into()));
     }
     let names = space.channels();
-    let channels: Vec<AnyChannel<FlatSamples>> = (0..3)
+    let mut channels: Vec<AnyChannel<FlatSamples>> = (0..3)
         .map(|c| AnyChannel::new(names[c], FlatSamples::F32(pixels.iter().map(|p| p[c] as f32).collect())))
         .collect();
+    let mut attributes = LayerAttributes::default();
+    if let Some((wavelengths, bins)) = spectral {
+        if bins.len() != wavelengths.len() || bins.iter().any(|b| b.len() != pixels.len()) {
+            return Err(bad("spectral buffer size does not match".into()));
+        }
+        for (l, b) in wavelengths.iter().zip(bins) {
+            channels.push(AnyChannel::new(spectral_channel_name(*l).as_str(), FlatSamples::F32(b.clone())));
+        }
+        attributes.other.insert(Text::from("spectralLayoutVersion"), AttributeValue::Text(Text::from("1.0")));
+        attributes.other.insert(Text::from("emissiveUnits"), AttributeValue::Text(Text::from("W.m^-2.sr^-1")));
+    }
     let layer = Layer::new(
         (width as usize, height as usize),
-        LayerAttributes::default(),
+        attributes,
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels.into()),
     );
@@ -117,6 +150,13 @@ pub fn encode_u16(linear: f64) -> u16 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spectral_channel_names_follow_fichet_2021() {
+        assert_eq!(spectral_channel_name(380.0), "S0.380,000000nm");
+        assert_eq!(spectral_channel_name(435.8), "S0.435,799988nm");
+        assert_eq!(spectral_channel_name(730.0), "S0.730,000000nm");
+    }
 
     #[test]
     fn encoding_clamps_and_follows_the_transfer_curve() {
