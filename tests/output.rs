@@ -151,3 +151,39 @@ fn spectral_exr_bins_reproduce_the_xyz() {
     let o = rust_v(&["render", "scenes/prism.ron", "-o", dir.join("x.png").to_str().unwrap(), "--spectral", "--quiet"]);
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--spectral needs an .exr"));
 }
+
+/// Through the binary: two halves rendered with `--passes` and `--spectral`, merged, give the
+/// same EXR bytes (colour and 36 bins) as one render of all passes.
+#[test]
+fn spectral_halves_merge_to_the_whole_render() {
+    let dir = temp_dir("spectral-merge");
+    let scene = root().join("scenes/spheres.ron");
+    let part = |name: &str, passes: Option<&str>| {
+        let out = dir.join(format!("{name}.exr"));
+        let ckpt = dir.join(format!("{name}.ckpt"));
+        let mut args = vec!["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet", "--spectral"];
+        args.extend_from_slice(&[
+            "--width",
+            "12",
+            "--height",
+            "8",
+            "--spp",
+            "6",
+            "--checkpoint",
+            ckpt.to_str().unwrap(),
+        ]);
+        if let Some(p) = passes {
+            args.extend_from_slice(&["--passes", p]);
+        }
+        let o = rust_v(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        (out, ckpt)
+    };
+    let (whole, _) = part("whole", None);
+    let (_, a) = part("a", Some("0..3"));
+    let (_, b) = part("b", Some("3..6"));
+    let merged = dir.join("merged.exr");
+    let o = rust_v(&["merge", b.to_str().unwrap(), a.to_str().unwrap(), "-o", merged.to_str().unwrap(), "--quiet"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(&merged).unwrap(), std::fs::read(&whole).unwrap());
+}
