@@ -61,8 +61,7 @@ pub fn spectral_channel_name(lambda_nm: f32) -> String {
 
 /// Writes an EXR like [`write_exr_in`] plus, when `spectral` is given (per pixel, the mean
 /// radiance of each bin at `wavelengths_nm`), one float channel per bin named as Fichet et al.
-/// 2021 specify ([`spectral_channel_name`]), with their `spectralLayoutVersion` and
-/// `emissiveUnits` attributes.
+/// 2021 specify ([`spectral_channel_name`]), with their `spectralLayoutVersion` attribute.
 pub fn write_exr(
     path: &Path,
     width: u32,
@@ -89,8 +88,10 @@ pub fn write_exr(
         for (l, b) in wavelengths.iter().zip(bins) {
             channels.push(AnyChannel::new(spectral_channel_name(*l).as_str(), FlatSamples::F32(b.clone())));
         }
+        // The layout's one required attribute. Its optional `emissiveUnits` is left out: the exr
+        // crate keeps custom attributes in a HashMap whose order changes from run to run, and
+        // with two of them the file's bytes would too (renders must be byte-reproducible).
         attributes.other.insert(Text::from("spectralLayoutVersion"), AttributeValue::Text(Text::from("1.0")));
-        attributes.other.insert(Text::from("emissiveUnits"), AttributeValue::Text(Text::from("W.m^-2.sr^-1")));
     }
     let layer = Layer::new(
         (width as usize, height as usize),
