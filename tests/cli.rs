@@ -137,6 +137,7 @@ fn help_documents_every_render_flag() {
         "--wavelengths",
         "--packet-size",
         "--max-bounces",
+        "--color-space",
     ] {
         assert!(help.contains(flag), "--help lacks {flag}");
     }

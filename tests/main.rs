@@ -13,6 +13,8 @@ mod fuzz;
 mod hostile;
 mod lights;
 mod metrics;
+mod output;
 mod scenes;
+mod spectra;
 mod spectral;
 mod stability;

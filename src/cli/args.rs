@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{ArgMatches, Args, FromArgMatches, Parser, Subcommand};
 
+use rust_v::color::ColorSpace;
 use rust_v::error::Error;
 use rust_v::settings::{FIELDS, SettingsPatch};
 
@@ -100,6 +101,15 @@ pub struct RenderArgs {
     /// Output image: `.png` (16-bit sRGB) or `.exr` (linear sRGB, float). Default: the scene's name with `.png`, in the current directory.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Colour space of EXR output: srgb (linear, default), rec2020, acescg (Bradford-adapted
+    /// from D65) or xyz. PNG output is always sRGB.
+    #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
+    pub color_space: ColorSpace,
+    /// With an .exr output: also write the 36 spectral bins (380-730 nm) as channels in the
+    /// layout of Fichet et al. 2021, summed exactly like the colour (the checkpoint then holds
+    /// them too, so resumed and merged renders stay bit-identical).
+    #[arg(long)]
+    pub spectral: bool,
     #[command(flatten)]
     pub settings: SettingsArgs,
     #[command(flatten)]
@@ -139,6 +149,10 @@ pub struct ResumeArgs {
     /// Output image, `.png` or `.exr` (default: the original render's output).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Colour space of EXR output: srgb (linear, default; not stored in the checkpoint: give it again), rec2020, acescg (Bradford-adapted
+    /// from D65) or xyz. PNG output is always sRGB.
+    #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
+    pub color_space: ColorSpace,
     #[command(flatten)]
     pub run: RunArgs,
     #[command(flatten)]
@@ -158,9 +172,18 @@ pub struct MergeArgs {
     /// Output: `.png` or `.exr` writes the image, `.ckpt` a merged checkpoint.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Colour space of EXR output: srgb (linear, default), rec2020, acescg (Bradford-adapted
+    /// from D65) or xyz. PNG output is always sRGB.
+    #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
+    pub color_space: ColorSpace,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A colour space by name.
+fn parse_color_space(s: &str) -> std::result::Result<ColorSpace, String> {
+    ColorSpace::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", ColorSpace::NAMES.join(", ")))
 }
 
 /// `A..B` with A < B.

@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
+use rust_v::color::ColorSpace;
 use rust_v::error::{Error, Result};
 use rust_v::film::{Film, MAX_SAMPLE};
 use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, parent_dir};
@@ -31,10 +32,20 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let session = Session::start()?;
     let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
     check_output_extension(&output)?;
+    check_color_space(&output, args.color_space)?;
+    if args.spectral && !rust_v::io::image::is_exr(&output) {
+        return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", output.display())));
+    }
     let load_start = Instant::now();
     let scene = load_scene(&args.scene, &args.settings.overrides())?;
     let load_time = load_start.elapsed();
     let s = &scene.settings;
+    if args.spectral
+        && s.integrator == rust_v::settings::IntegratorKind::Spectral
+        && s.wavelengths == rust_v::settings::WavelengthsKind::Rgb
+    {
+        return Err(Error::Settings("--spectral: the RGB mode (--wavelengths rgb) has no spectral bins".into()));
+    }
     if !args.run.quiet {
         say(format_args!(
             "{} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}",
@@ -54,17 +65,22 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output));
-    check_files(&args.scene, &scene, &[], &output, &checkpoint_path)?;
+    check_files(&args.scene, &scene, &[], &output, &checkpoint_path, args.spectral)?;
     let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
-    let checkpoint = Checkpoint {
+    let mut checkpoint = Checkpoint {
         crate_version: env!("CARGO_PKG_VERSION").into(),
         scene_path,
         content_hash: scene.content_hash,
         settings: scene.settings.clone(),
         target_end: passes.end,
         output: std::path::absolute(&output).map_err(|e| Error::io(&output, e))?,
-        film: Film::starting_at(s.width, s.height, passes.start),
+        film: if args.spectral {
+            Film::new_spectral(s.width, s.height, passes.start)
+        } else {
+            Film::starting_at(s.width, s.height, passes.start)
+        },
     };
+    checkpoint.film.set_color_space(args.color_space);
     let plan = SessionPlan {
         checkpoint_path,
         final_checkpoint: args.checkpoint.checkpoint.is_some(),
@@ -99,6 +115,8 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     }
     let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
     check_output_extension(&output)?;
+    check_color_space(&output, args.color_space)?;
+    ckpt.film.set_color_space(args.color_space);
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
     if scene.content_hash != ckpt.content_hash && args.force {
@@ -139,7 +157,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     // The checkpoint resumed is an input unless it is also where new checkpoints go.
     let resumed = [("checkpoint resumed", path.as_path())];
     let extra: &[(&str, &Path)] = if args.checkpoint.checkpoint.is_some() { &resumed } else { &[] };
-    check_files(&ckpt.scene_path, &scene, extra, &output, &checkpoint_path)?;
+    check_files(&ckpt.scene_path, &scene, extra, &output, &checkpoint_path, ckpt.film.spectral_sums().is_some())?;
     let plan = SessionPlan {
         checkpoint_path,
         final_checkpoint: args.checkpoint.checkpoint.is_some(),
@@ -165,7 +183,11 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     for p in &args.parts {
         parts.push((p.clone(), Checkpoint::read(p)?));
     }
-    let merged = merge(parts)?;
+    let mut merged = merge(parts)?;
+    if !is_ckpt {
+        check_color_space(&args.output, args.color_space)?;
+        merged.film.set_color_space(args.color_space);
+    }
     if is_ckpt {
         merged.write(&args.output)?;
     } else {
@@ -180,6 +202,18 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
             r.end,
             args.output.display()
         ));
+    }
+    Ok(())
+}
+
+/// A colour space other than sRGB needs an EXR output.
+fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
+    if space != ColorSpace::Srgb && !rust_v::io::image::is_exr(output) {
+        return Err(Error::Settings(format!(
+            "--color-space {} needs an .exr output; {} is a PNG, always sRGB",
+            space.name(),
+            output.display()
+        )));
     }
     Ok(())
 }
@@ -201,6 +235,7 @@ fn check_files(
     extra_inputs: &[(&str, &Path)],
     output: &Path,
     checkpoint: &Path,
+    spectral: bool,
 ) -> Result<()> {
     check_output(output, "image")?;
     check_output(checkpoint, "checkpoint")?;
@@ -228,7 +263,7 @@ fn check_files(
             )));
         }
     }
-    check_memory(scene.settings.width, scene.settings.height)?;
+    check_memory(scene.settings.width, scene.settings.height, spectral)?;
     for (i, light) in scene.lights.iter().enumerate() {
         let peak = light.spectrum().max_value();
         if peak > MAX_SAMPLE {
@@ -242,8 +277,8 @@ fn check_files(
 
 /// Refuses a film larger than the memory this machine has available (Linux:
 /// `MemAvailable` in /proc/meminfo; elsewhere not checked).
-fn check_memory(width: u32, height: u32) -> Result<()> {
-    let need = Film::bytes_needed(width, height);
+fn check_memory(width: u32, height: u32, spectral: bool) -> Result<()> {
+    let need = Film::bytes_needed(width, height, spectral);
     let Some(available) = available_memory() else { return Ok(()) };
     if need > available {
         return Err(Error::Settings(format!(

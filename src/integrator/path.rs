@@ -20,12 +20,12 @@
 //!    and divide `β` by `q` (unbiased).
 
 use crate::bxdf::{BsdfSample, Dispersion, fresnel_dielectric};
-use crate::color::{N_BINS, Sampled, Xyz};
+use crate::color::{N_BINS, Sampled};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
-use crate::spectral::{BinDistribution, Lambdas, Readout, bin_importance, for_each_rotated};
+use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated};
 
 use super::{Shading, sample_direct};
 
@@ -66,9 +66,15 @@ struct Walk<const N: usize> {
 
 impl PathTracer {
     /// Radiance arriving along `ray` for the packet `lambdas`, as XYZ.
-    pub fn li<const N: usize>(&self, scene: &Scene, ray: Ray, lambdas: &Lambdas<N>, sampler: &mut Sampler) -> Xyz {
+    pub(crate) fn li<const N: usize, O: Contribution>(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        lambdas: &Lambdas<N>,
+        sampler: &mut Sampler,
+    ) -> O {
         let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
-            return Xyz::default();
+            return O::default();
         };
         let walk = Walk {
             beta: Sampled::splat(1.0),
@@ -81,7 +87,7 @@ impl PathTracer {
 
     /// Continues a path that arrived along `ray` at `si`.
     #[allow(clippy::too_many_arguments)]
-    fn walk<const N: usize>(
+    fn walk<const N: usize, O: Contribution>(
         &self,
         scene: &Scene,
         mut ray: Ray,
@@ -90,9 +96,9 @@ impl PathTracer {
         lambdas: &Lambdas<N>,
         sampler: &mut Sampler,
         mut start: Start,
-    ) -> Xyz {
+    ) -> O {
         let mut l = Sampled::<N>::splat(0.0);
-        let mut split = Xyz::default();
+        let mut split = O::default();
         let mut add_emission = start == Start::Camera;
         loop {
             let object = &scene.objects[si.object as usize];
@@ -136,7 +142,7 @@ impl PathTracer {
                 } else {
                     for i in 0..N {
                         let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
-                        split += self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
+                        split += self.walk::<1, O>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
                     }
                     break;
                 }
@@ -181,7 +187,9 @@ impl PathTracer {
                 None => break,
             }
         }
-        lambdas.xyz(&l) + split
+        let mut out = O::from_packet(lambdas, &l);
+        out += split;
+        out
     }
 }
 
@@ -208,7 +216,7 @@ impl PathTracer {
     /// reflected.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn collapse<const N: usize>(
+    fn collapse<const N: usize, O: Contribution>(
         &self,
         scene: &Scene,
         ray: Ray,
@@ -218,7 +226,7 @@ impl PathTracer {
         w: &Walk<N>,
         lambdas: &Lambdas<N>,
         sampler: &mut Sampler,
-        split: &mut Xyz,
+        split: &mut O,
     ) -> Option<Sampled<N>> {
         let importance = bin_importance();
         let cos = sh.wo.z;
@@ -251,7 +259,7 @@ impl PathTracer {
             };
             let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
-            *split += self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
+            *split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
         });
         None
     }

@@ -115,6 +115,19 @@ pub enum SpectrumDesc {
     Blackbody(f32),
     /// A spectrum times a factor: `Scaled(10, D65)`.
     Scaled(f32, Box<SpectrumDesc>),
+    /// `(nm, value)` pairs at any wavelengths in increasing order, linear between them and flat
+    /// beyond the ends, sampled at the 36 bin centres: `Table([(400, 0.1), (550, 0.8), (700, 0.3)])`.
+    Table(Vec<(f32, f32)>),
+    /// A two-column CSV file (`nm,value` per line, relative to the scene file; a header line,
+    /// blank lines and `#` comments are allowed), read like `Table`: `File("data/led.csv")`.
+    File(String),
+    /// Linear sRGB, uplifted to a smooth spectrum (Jakob and Hanika 2019): as a reflectance
+    /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
+    /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
+    Rgb(f32, f32, f32),
+    /// A spectrum scaled to the given luminance Y (a flat spectrum of 1 has Y = 1):
+    /// `Luminance(5, Blackbody(3000))` is a 3000 K emitter as bright as `Constant(5)`.
+    Luminance(f32, Box<SpectrumDesc>),
 }
 
 /// An index of refraction in the scene file.

@@ -14,7 +14,7 @@ use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, Oren
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
-use crate::io::{Fnv1a, fnv1a, parse_mesh, read_input};
+use crate::io::{Fnv1a, fnv1a, parse_mesh, parse_spectrum_file, read_input};
 use crate::light::{AreaLight, BeamLight, DiskLight, DistantLight, Light, PointLight, SphereLight, SpotLight};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
@@ -137,6 +137,15 @@ struct Input {
     hash: u64,
 }
 
+/// What a spectrum describes: it decides what `Rgb(r, g, b)` means.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// A reflectance: the uplifted colour itself, within [0, 1].
+    Reflectance,
+    /// An emission or intensity: the uplifted colour times D65.
+    Emission,
+}
+
 struct Ctx<'a> {
     path: &'a Path,
     dir: PathBuf,
@@ -181,7 +190,46 @@ impl Ctx<'_> {
         v.try_normalize().ok_or_else(|| self.err(field, "expected a non-zero direction"))
     }
 
+    /// A text file the scene refers to (a spectrum table), read through
+    /// [`Ctx::read_input`] like every input: the resolved path and the text.
+    fn read_text_input(&self, field: &str, rel: &str) -> Result<(PathBuf, String)> {
+        let (path, bytes) = self.read_input(field, rel)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            self.err(field, format!("\"{}\": byte {at} is not UTF-8; expected a UTF-8 text file", path.display()))
+        })?;
+        Ok((path, text))
+    }
+
+    /// Checks a table's points (finite, wavelengths strictly increasing, at least one).
+    fn table(&self, field: &str, points: &[(f32, f32)]) -> Result<Spectrum> {
+        if points.is_empty() {
+            return Err(self.err(field, "expected at least one (nm, value) pair"));
+        }
+        for (k, w) in points.iter().enumerate() {
+            if !(w.0.is_finite() && w.1.is_finite() && w.0 > 0.0) {
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("expected a positive wavelength in nm and a finite value, found {w:?}"),
+                ));
+            }
+            if k > 0 && w.0 <= points[k - 1].0 {
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("wavelengths must increase: {} nm follows {} nm", w.0, points[k - 1].0),
+                ));
+            }
+        }
+        Ok(Spectrum::from_table(points))
+    }
+
+    /// A spectrum for emission or intensity (any non-negative values).
     fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+        self.spectrum_as(field, s, Role::Emission)
+    }
+
+    /// A spectrum in a role; the role decides what `Rgb` means.
+    fn spectrum_as(&self, field: &str, s: &SpectrumDesc, role: Role) -> Result<Spectrum> {
         let out = match s {
             SpectrumDesc::Constant(v) => Spectrum::splat(*v),
             SpectrumDesc::Samples(v) => {
@@ -205,7 +253,47 @@ impl Ctx<'_> {
             SpectrumDesc::EqualEnergy => color::equal_energy(),
             SpectrumDesc::Blackbody(t) => color::blackbody(*t)
                 .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
-            SpectrumDesc::Scaled(k, inner) => self.spectrum(field, inner)? * *k,
+            SpectrumDesc::Scaled(k, inner) => self.spectrum_as(field, inner, role)? * *k,
+            SpectrumDesc::Table(points) => self.table(field, points)?,
+            SpectrumDesc::File(rel) => {
+                let (path, text) = self.read_text_input(field, rel)?;
+                let points = parse_spectrum_file(&text).map_err(|e| Error::Scene {
+                    path: path.clone(),
+                    position: Some((e.line, e.col)),
+                    field: field.to_string(),
+                    message: e.message,
+                })?;
+                self.table(field, &points).map_err(|e| match e {
+                    Error::Scene { field, message, .. } => {
+                        Error::Scene { path: path.clone(), position: None, field, message }
+                    }
+                    e => e,
+                })?
+            }
+            SpectrumDesc::Rgb(r, g, b) => {
+                let rgb = [*r, *g, *b];
+                let limit = if role == Role::Reflectance { 1.0 } else { MAX_MAGNITUDE };
+                if !rgb.iter().all(|v| v.is_finite() && (0.0..=limit).contains(v)) {
+                    return Err(
+                        self.err(field, format!("expected linear sRGB components in [0, {limit}], found {rgb:?}"))
+                    );
+                }
+                match role {
+                    Role::Reflectance => color::rgb_reflectance(rgb),
+                    Role::Emission => color::rgb_emission(rgb),
+                }
+            }
+            SpectrumDesc::Luminance(y, inner) => {
+                let s = self.spectrum_as(field, inner, role)?;
+                let have = s.to_xyz().y;
+                if !(y.is_finite() && *y >= 0.0 && *y <= MAX_MAGNITUDE) {
+                    return Err(self.err(field, format!("expected a luminance in [0, {MAX_MAGNITUDE:e}], found {y}")));
+                }
+                if !(have > 0.0 && have.is_finite()) {
+                    return Err(self.err(field, format!("cannot scale a spectrum of luminance {have} to {y}")));
+                }
+                s * (*y / have)
+            }
         };
         if out.has_nan_or_inf() || out.min_value() < 0.0 || out.max_value() > MAX_MAGNITUDE {
             return Err(self.err(field, format!("expected finite, non-negative values up to {MAX_MAGNITUDE:e}")));
@@ -214,7 +302,7 @@ impl Ctx<'_> {
     }
 
     fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
-        let r = self.spectrum(field, s)?;
+        let r = self.spectrum_as(field, s, Role::Reflectance)?;
         if r.max_value() > 1.0 {
             return Err(self.err(field, format!("a reflectance must lie in [0, 1], found {}", r.max_value())));
         }
