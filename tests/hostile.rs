@@ -456,4 +456,11 @@ fn resume_and_merge_refuse_changed_meshes() {
     assert!(o.status.success() && stderr(&o).contains("warning"), "{}", stderr(&o));
     let e = one_error(&run(&["merge", s(&a), s(&b), "-o", s(&d.join("m.png"))]), 1);
     assert!(e.contains("different scene"), "{e}");
+    // A spectrum file is an input too.
+    std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.8\n").unwrap();
+    std::fs::write(&scene, SCENE.replace("Constant(0.5)", "File(\"refl.csv\")")).unwrap();
+    let c = part("c", "0..1");
+    std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.7\n").unwrap();
+    let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
+    assert!(e.contains("changed"), "{e}");
 }
