@@ -24,19 +24,24 @@
 //! is in. The dielectric is oriented: `+z` is outside (the side the geometric
 //! normal points to), so `wo.z < 0` means the path is inside the glass.
 
+mod conductor;
 mod dielectric;
 mod fresnel;
 mod ior;
 mod lambertian;
+mod metals;
+pub mod microfacet;
 mod oren_nayar;
 mod specular;
 #[cfg(test)]
 mod tests;
 
+pub use conductor::Conductor;
 pub use dielectric::Dielectric;
-pub use fresnel::{fresnel_dielectric, refract};
+pub use fresnel::{fresnel_conductor, fresnel_dielectric, refract};
 pub use ior::{Ior, NAMED_GLASSES, named_glass};
 pub use lambertian::Lambertian;
+pub use metals::{NAMED_METALS, named_metal};
 pub use oren_nayar::OrenNayar;
 pub use specular::Mirror;
 
@@ -74,6 +79,8 @@ pub enum Bxdf {
     Mirror(Mirror),
     /// A smooth dielectric interface (glass, water): Fresnel reflection and refraction.
     Dielectric(Dielectric),
+    /// A metal with a complex index, smooth or rough (GGX).
+    Conductor(Conductor),
 }
 
 impl Bxdf {
@@ -83,6 +90,7 @@ impl Bxdf {
         match self {
             Bxdf::Lambertian(m) => m.eval(wo, wi, lambdas),
             Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
+            Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
             Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => Sampled::splat(0.0),
         }
     }
@@ -97,6 +105,7 @@ impl Bxdf {
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
             Bxdf::Dielectric(m) => m.sample(wo, uc, m.eta_for(lambdas)),
+            Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
         }
     }
 
@@ -105,6 +114,7 @@ impl Bxdf {
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
+            Bxdf::Conductor(m) => m.pdf(wo, wi),
             Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => 0.0,
         }
     }
@@ -112,7 +122,11 @@ impl Bxdf {
     /// True when the model's directions are all delta (no light sampling pays).
     #[inline]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Bxdf::Mirror(_) | Bxdf::Dielectric(_))
+        match self {
+            Bxdf::Mirror(_) | Bxdf::Dielectric(_) => true,
+            Bxdf::Conductor(c) => c.is_smooth(),
+            Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => false,
+        }
     }
 
     /// How the model disperses, when `sample`'s direction depends on the

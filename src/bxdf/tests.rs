@@ -7,6 +7,7 @@ use std::f64::consts::PI;
 
 use glam::{Vec2, Vec3};
 
+use super::microfacet::SMOOTH_ALPHA;
 use super::test_util::check_sample_consistency;
 use super::*;
 use crate::color::{N_BINS, Spectrum};
@@ -126,7 +127,12 @@ const PHI_RES: usize = 31;
 /// is split into 16), so the rule's error (~1e-4 relative) is far below the
 /// test's sensitivity. Never uses the sampler.
 fn expected_counts(pdf: impl Fn(Vec3) -> f32, n: usize) -> Vec<f64> {
-    let sub = 16;
+    expected_counts_sub(pdf, n, 16)
+}
+
+/// As [`expected_counts`] with `sub × sub` midpoint sub-cells per cell (the
+/// peaked microfacet lobes need a finer rule).
+fn expected_counts_sub(pdf: impl Fn(Vec3) -> f32, n: usize, sub: usize) -> Vec<f64> {
     let mut out = vec![0.0; THETA_RES * PHI_RES];
     for i in 0..THETA_RES {
         for j in 0..PHI_RES {
@@ -235,6 +241,42 @@ fn chi_square_sample_matches_pdf() {
     }
 }
 
+/// GGX rough conductors (visible-normal sampling) at several widths and
+/// incident angles, from above and below: as `chi_square_sample_matches_pdf`,
+/// with a 48 × 48 midpoint rule per cell, whose relative error on the
+/// narrowest lobe (α = 0.15, ~0.1% in the pole cell) stays below a third of
+/// the cell's standard error at 100k samples. Šidák-corrected 1% overall.
+#[test]
+fn chi_square_rough_conductor() {
+    let (eta, k) = named_metal("Cu").unwrap();
+    let alphas = [0.15f32, 0.4, 1.0];
+    let thetas = [0.0f32, 45.0, 80.0, 135.0];
+    let tests = alphas.len() * thetas.len();
+    let sig = 1.0 - 0.99f64.powf(1.0 / tests as f64);
+    let n = 100_000;
+    let mut seed = 100;
+    for alpha in alphas {
+        let b = Bxdf::Conductor(Conductor { eta, k, alpha });
+        for theta in thetas {
+            let t = theta.to_radians();
+            let wo = Vec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos()).normalize();
+            let expected = expected_counts_sub(|wi| b.pdf(wo, wi), n, 48);
+            seed += 1;
+            let l = Lambdas::<1> { pos: [20.0], weight: 36.0, readout: crate::spectral::Readout::Spectral };
+            let mut s = Sampler::new(seed, 11, 13);
+            let mut observed = vec![0.0; THETA_RES * PHI_RES];
+            for _ in 0..n {
+                if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l) {
+                    assert!(!bs.is_delta && bs.pdf > 0.0 && bs.wi.z * wo.z > 0.0);
+                    observed[cell(bs.wi)] += 1.0;
+                }
+            }
+            let p = chi2_test(&observed, &expected);
+            assert!(p > sig, "GGX α {alpha}, θo = {theta}°: p = {p:e} < {sig:e}");
+        }
+    }
+}
+
 /// The test has power: a uniform-hemisphere sampler is rejected against the
 /// cosine pdf (p below 1e-12), so the passing results above mean something.
 #[test]
@@ -267,7 +309,17 @@ fn all_models() -> Vec<(&'static str, Bxdf)> {
         ("Mirror", Bxdf::Mirror(Mirror { reflectance: rho })),
         ("Dielectric 1.5", Bxdf::Dielectric(Dielectric::new(Ior::Constant(1.5)))),
         ("Dielectric N-SF11", Bxdf::Dielectric(Dielectric::new(named_glass("N-SF11").unwrap()))),
+        ("Conductor Au", conductor("Au", 0.0)),
+        ("Conductor Cu α=0.001", conductor("Cu", SMOOTH_ALPHA)),
+        ("Conductor Al α=0.05", conductor("Al", 0.05)),
+        ("Conductor CuZn α=0.3", conductor("CuZn", 0.3)),
+        ("Conductor Ag α=1", conductor("Ag", 1.0)),
     ]
+}
+
+fn conductor(metal: &str, alpha: f32) -> Bxdf {
+    let (eta, k) = named_metal(metal).unwrap();
+    Bxdf::Conductor(Conductor { eta, k, alpha })
 }
 
 /// Incident cosines from normal to grazing, on both sides: down to 1e-6
@@ -328,7 +380,19 @@ fn every_model_conserves_energy_at_all_angles_and_wavelengths() {
                 assert!(a[i] >= 0.0);
             }
             // A white diffuse surface keeps at least half (Oren-Nayar at σ = 90° keeps A = 0.56 at normal incidence).
-            if !matches!(b, Bxdf::Mirror(_)) {
+            if let Bxdf::Conductor(m) = &b {
+                if m.is_smooth() {
+                    let f = m.fresnel(wo.z, &Lambdas::full());
+                    for i in 0..N_BINS {
+                        assert!(
+                            (a[i] - f[i]).abs() < 1e-4 * f[i],
+                            "{name}: cos {c}: albedo {} is not F = {}",
+                            a[i],
+                            f[i]
+                        );
+                    }
+                }
+            } else if !matches!(b, Bxdf::Mirror(_)) {
                 let white = match &b {
                     Bxdf::OrenNayar(_) | Bxdf::Lambertian(_) => a[N_BINS - 1],
                     _ => unreachable!(),
@@ -400,5 +464,106 @@ fn grazing_directions_never_give_nan_or_infinity() {
                 assert!(!f.has_nan_or_inf(), "{name} eval at cos {cos:e}");
             }
         }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Rough conductors: energy against an independent numerical integral, and
+// continuity towards the smooth model.
+
+/// GGX D and Smith Λ written out in f64 from their textbook forms (with the
+/// tangent), independent of `microfacet.rs`.
+fn ggx_d_f64(alpha: f64, cos_m: f64) -> f64 {
+    if cos_m <= 0.0 {
+        return 0.0;
+    }
+    let tan2 = (1.0 - cos_m * cos_m) / (cos_m * cos_m);
+    let c4 = cos_m.powi(4);
+    1.0 / (PI * alpha * alpha * c4 * (1.0 + tan2 / (alpha * alpha)).powi(2))
+}
+
+fn smith_lambda_f64(alpha: f64, cos: f64) -> f64 {
+    let tan2 = (1.0 - cos * cos) / (cos * cos);
+    0.5 * ((1.0 + alpha * alpha * tan2).sqrt() - 1.0)
+}
+
+/// The directional albedo of a GGX perfect reflector (F = 1),
+/// E(μo) = ∫ D(h) G2(o, i) / (4 μo) dωi over the upper hemisphere, by the
+/// midpoint rule on a (θ, φ) grid dense near the mirror direction.
+fn ggx_albedo_integral(alpha: f64, mu_o: f64) -> f64 {
+    let (nt, np) = (1200, 600);
+    let wo = [(1.0 - mu_o * mu_o).sqrt(), 0.0, mu_o];
+    let mut sum = 0.0;
+    for i in 0..nt {
+        let theta = (i as f64 + 0.5) / nt as f64 * std::f64::consts::FRAC_PI_2;
+        let dtheta = std::f64::consts::FRAC_PI_2 / nt as f64;
+        for j in 0..np {
+            let phi = (j as f64 + 0.5) / np as f64 * 2.0 * PI;
+            let wi = [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()];
+            let h = [wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]];
+            let len = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+            let g2 = 1.0 / (1.0 + smith_lambda_f64(alpha, mu_o) + smith_lambda_f64(alpha, wi[2]));
+            sum += ggx_d_f64(alpha, h[2] / len) * g2 / (4.0 * mu_o) * theta.sin() * dtheta * 2.0 * PI / np as f64;
+        }
+    }
+    sum
+}
+
+/// White furnace of a rough perfect reflector (n = 0, k = 1 gives F = 1
+/// exactly at every angle): the Monte Carlo albedo of `sample` (weights
+/// G2/G1, 200k samples, standard error below 0.1%) matches the numerical
+/// integral of D·G2/(4μo) within 0.5% at α = 0.1, 0.3, 0.6, 1.0 and
+/// μo = 1, 0.5, 0.15; the loss grows with α and towards grazing (single
+/// scattering loses what Kulla and Conty 2017 restore by multiple scattering:
+/// at α = 1 and normal incidence about 40%).
+#[test]
+fn rough_perfect_reflector_albedo_matches_the_integral() {
+    let white = |alpha| Bxdf::Conductor(Conductor { eta: Spectrum::ZERO, k: Spectrum::ONE, alpha });
+    assert_eq!(fresnel_conductor(0.3, 0.0, 1.0), 1.0);
+    let mut last = 1.0f64;
+    for alpha in [0.1f32, 0.3, 0.6, 1.0] {
+        for mu in [1.0f32, 0.5, 0.15] {
+            let wo = dir(mu, 0.4);
+            let mc = check_sample_consistency(&white(alpha), wo, 200_000)[0] as f64;
+            let want = ggx_albedo_integral(alpha as f64, mu as f64);
+            assert!((mc - want).abs() < 5e-3 * want, "α {alpha} μ {mu}: MC {mc} vs integral {want}");
+            assert!(want <= 1.0 + 1e-3);
+            if mu == 1.0 {
+                assert!(want < last + 1e-3, "loss grows with α");
+                last = want;
+            }
+        }
+    }
+    // At α = 1, D = 1/π and G2 = 2μi/(1 + μi) seen from the normal, so E = ∫₀¹ μ/(1+μ) dμ = 1 − ln 2.
+    assert!((last - (1.0 - 2f64.ln())).abs() < 1e-3, "α = 1, normal incidence: {last}");
+}
+
+/// Roughness near 0 approaches the smooth model continuously: at α just
+/// above the smooth threshold the rough lobe's albedo is the smooth
+/// conductor's F(θo) within 0.5% per bin (gold, from normal to 84°), and
+/// at least 95% of its samples leave within 1° of the mirror direction
+/// (GGX's tails put P(tan θm > t) = α² / (α² + t²), 1.3% beyond 0.5° for the
+/// half vector).
+#[test]
+fn rough_conductor_tends_to_the_smooth_one() {
+    let l = Lambdas::full();
+    let smooth = conductor("Au", 0.0);
+    let rough = conductor("Au", SMOOTH_ALPHA * 1.001);
+    assert!(smooth.is_delta() && !rough.is_delta());
+    for mu in [1.0f32, 0.5, 0.1] {
+        let wo = dir(mu, 0.9);
+        let a = check_sample_consistency(&rough, wo, 2000);
+        let s = check_sample_consistency(&smooth, wo, 1);
+        for i in 0..N_BINS {
+            assert!((a[i] - s[i]).abs() < 5e-3 * s[i], "μ {mu} bin {i}: {} vs {}", a[i], s[i]);
+        }
+        let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
+        let mut smp = Sampler::new(9, 9, 9);
+        let mut near = 0;
+        for _ in 0..1000 {
+            let bs = rough.sample(wo, smp.next_2d(), smp.next_1d(), &l).unwrap();
+            near += (bs.wi.dot(mirror) > 1f32.to_radians().cos()) as usize;
+        }
+        assert!(near >= 950, "μ {mu}: {near} of 1000 within 1°");
     }
 }

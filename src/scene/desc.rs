@@ -138,6 +138,23 @@ pub enum MaterialDesc {
         /// Index of refraction of the inside.
         ior: IorDesc,
     },
+    /// A metal: `Conductor(metal: "Au")` (Au, Ag, Cu, Al, Cr, CuZn) or
+    /// `Conductor(eta: SPECTRUM, k: SPECTRUM)`, optionally `roughness: A`
+    /// (GGX α as Mitsuba's `alpha`; 0, the default, is a smooth metal).
+    Conductor {
+        /// A named metal (exclusive with `eta` and `k`).
+        #[serde(default)]
+        metal: Option<String>,
+        /// The real part of the complex index, per wavelength.
+        #[serde(default)]
+        eta: Option<SpectrumDesc>,
+        /// The extinction coefficient (imaginary part), per wavelength.
+        #[serde(default)]
+        k: Option<SpectrumDesc>,
+        /// GGX α in [0, 1] (default 0: smooth).
+        #[serde(default)]
+        roughness: f32,
+    },
     /// Absorbs everything.
     Black,
 }

@@ -9,7 +9,10 @@ use glam::Vec3;
 
 use super::desc::{IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
 use super::{Object, Scene};
-use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, OrenNayar, named_glass};
+use crate::bxdf::{
+    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, named_glass,
+    named_metal,
+};
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
@@ -165,8 +168,41 @@ impl Ctx<'_> {
             MaterialDesc::Dielectric { ior } => {
                 Bxdf::Dielectric(Dielectric::new(self.ior(&format!("{field}.ior"), ior)?))
             }
+            MaterialDesc::Conductor { metal, eta, k, roughness } => {
+                let (eta, k) = match (metal, eta, k) {
+                    (Some(name), None, None) => named_metal(name).ok_or_else(|| {
+                        let names: Vec<&str> = NAMED_METALS.iter().map(|m| m.0).collect();
+                        self.err(
+                            format!("{field}.metal"),
+                            format!("unknown metal \"{name}\"; expected one of: {}", names.join(", ")),
+                        )
+                    })?,
+                    (None, Some(eta), Some(k)) => {
+                        let eta_s = self.spectrum(&format!("{field}.eta"), eta)?;
+                        if eta_s.min_value() <= 0.0 {
+                            return Err(
+                                self.err(format!("{field}.eta"), "expected a positive index at every wavelength")
+                            );
+                        }
+                        (eta_s, self.spectrum(&format!("{field}.k"), k)?)
+                    }
+                    _ => {
+                        return Err(self.err(field, "expected either `metal: \"Au\"` or both `eta:` and `k:` spectra"));
+                    }
+                };
+                Bxdf::Conductor(Conductor { eta, k, alpha: self.roughness(&format!("{field}.roughness"), *roughness)? })
+            }
             MaterialDesc::Black => Bxdf::Black,
         })
+    }
+
+    /// A GGX α: a number in [0, 1] (0 is smooth).
+    fn roughness(&self, field: &str, alpha: f32) -> Result<f32> {
+        if alpha.is_finite() && (0.0..=1.0).contains(&alpha) {
+            Ok(alpha)
+        } else {
+            Err(self.err(field, format!("expected a GGX alpha in [0, 1], found {alpha}")))
+        }
     }
 
     fn shape(&self, field: &str, d: &ShapeDesc) -> Result<Shape> {
