@@ -32,6 +32,7 @@ mod lambertian;
 mod metals;
 pub mod microfacet;
 mod oren_nayar;
+mod rough_dielectric;
 mod specular;
 #[cfg(test)]
 mod tests;
@@ -47,7 +48,7 @@ pub use specular::Mirror;
 
 use glam::{Vec2, Vec3};
 
-use crate::color::Sampled;
+use crate::color::{Sampled, Spectrum};
 use crate::spectral::Lambdas;
 
 /// A sampled direction with its value and pdf.
@@ -91,7 +92,8 @@ impl Bxdf {
             Bxdf::Lambertian(m) => m.eval(wo, wi, lambdas),
             Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
             Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
-            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => Sampled::splat(0.0),
+            Bxdf::Dielectric(m) => Sampled::splat(m.eval(wo, wi, m.eta_for(lambdas))),
+            Bxdf::Black | Bxdf::Mirror(_) => Sampled::splat(0.0),
         }
     }
 
@@ -104,18 +106,20 @@ impl Bxdf {
             Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
-            Bxdf::Dielectric(m) => m.sample(wo, uc, m.eta_for(lambdas)),
+            Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas)),
             Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
         }
     }
 
-    /// The pdf of sampling `wi` given `wo` (zero for delta models).
+    /// The pdf of sampling `wi` given `wo` for the packet `lambdas` (zero
+    /// for delta models; rough glass samples at the packet's index, as `sample`).
     #[inline]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub fn pdf<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> f32 {
         match self {
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
             Bxdf::Conductor(m) => m.pdf(wo, wi),
-            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => 0.0,
+            Bxdf::Dielectric(m) => m.pdf(wo, wi, m.eta_for(lambdas)),
+            Bxdf::Black | Bxdf::Mirror(_) => 0.0,
         }
     }
 
@@ -123,7 +127,8 @@ impl Bxdf {
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Bxdf::Mirror(_) | Bxdf::Dielectric(_) => true,
+            Bxdf::Mirror(_) => true,
+            Bxdf::Dielectric(d) => d.is_smooth(),
             Bxdf::Conductor(c) => c.is_smooth(),
             Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => false,
         }
@@ -145,6 +150,17 @@ impl Bxdf {
         self.dispersion().is_some()
     }
 
+    /// The absorption coefficient (per unit length) inside the model, for
+    /// an absorbing dielectric: the integrators attenuate every segment that
+    /// reaches this surface from its inside by `exp(−σ t)`.
+    #[inline]
+    pub fn absorption(&self) -> Option<&Spectrum> {
+        match self {
+            Bxdf::Dielectric(d) => d.absorption(),
+            _ => None,
+        }
+    }
+
     /// True when the model absorbs everything (a path ends here).
     #[inline]
     pub fn is_black(&self) -> bool {
@@ -160,6 +176,15 @@ impl Bxdf {
 pub struct Dispersion<'a>(&'a Dielectric);
 
 impl Dispersion<'_> {
+    /// True for smooth glass: its reflection sends every wavelength the same
+    /// way, so `auto` may keep the full spectrum there. A rough dispersive
+    /// glass is instead split into single wavelengths before sampling (each
+    /// then samples, and takes its light sample, at its own index).
+    #[inline]
+    pub fn is_smooth(&self) -> bool {
+        self.0.is_smooth()
+    }
+
     /// The relative index at the reference wavelength, 589.3 nm.
     #[inline]
     pub fn reference_eta(&self) -> f32 {
@@ -213,7 +238,7 @@ pub(crate) mod test_util {
                 for i in 0..36 {
                     assert!((f[i] - bs.f[i]).abs() <= 1e-5 * f[i].abs().max(1.0), "eval != sample at bin {i}");
                 }
-                assert!((b.pdf(wo, bs.wi) - bs.pdf).abs() <= 1e-4 * bs.pdf);
+                assert!((b.pdf(wo, bs.wi, &l) - bs.pdf).abs() <= 1e-4 * bs.pdf);
             }
             let w = bs.f * (bs.wi.z.abs() / bs.pdf);
             albedo += w;

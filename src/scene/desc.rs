@@ -133,10 +133,17 @@ pub enum MaterialDesc {
         /// Reflectance.
         reflectance: SpectrumDesc,
     },
-    /// Smooth glass.
+    /// Glass: `Dielectric(ior: Named("N-BK7"))`, optionally rough
+    /// (`roughness: A`, GGX α) and absorbing (`absorption: SPECTRUM`, per unit length).
     Dielectric {
         /// Index of refraction of the inside.
         ior: IorDesc,
+        /// GGX α in [0, 1] (default 0: smooth).
+        #[serde(default)]
+        roughness: f32,
+        /// Absorption coefficient inside, per scene unit (default: clear).
+        #[serde(default)]
+        absorption: Option<SpectrumDesc>,
     },
     /// A metal: `Conductor(metal: "Au")` (Au, Ag, Cu, Al, Cr, CuZn) or
     /// `Conductor(eta: SPECTRUM, k: SPECTRUM)`, optionally `roughness: A`

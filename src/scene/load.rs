@@ -165,8 +165,13 @@ impl Ctx<'_> {
             MaterialDesc::Mirror { reflectance } => {
                 Bxdf::Mirror(Mirror { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
             }
-            MaterialDesc::Dielectric { ior } => {
-                Bxdf::Dielectric(Dielectric::new(self.ior(&format!("{field}.ior"), ior)?))
+            MaterialDesc::Dielectric { ior, roughness, absorption } => {
+                let mut d = Dielectric::new(self.ior(&format!("{field}.ior"), ior)?)
+                    .with_roughness(self.roughness(&format!("{field}.roughness"), *roughness)?);
+                if let Some(a) = absorption {
+                    d = d.with_absorption(self.spectrum(&format!("{field}.absorption"), a)?);
+                }
+                Bxdf::Dielectric(d)
             }
             MaterialDesc::Conductor { metal, eta, k, roughness } => {
                 let (eta, k) = match (metal, eta, k) {
