@@ -32,6 +32,7 @@ mod lambertian;
 mod metals;
 pub mod microfacet;
 mod oren_nayar;
+mod plastic;
 mod rough_dielectric;
 mod specular;
 #[cfg(test)]
@@ -44,6 +45,7 @@ pub use ior::{Ior, NAMED_GLASSES, named_glass};
 pub use lambertian::Lambertian;
 pub use metals::{NAMED_METALS, named_metal};
 pub use oren_nayar::OrenNayar;
+pub use plastic::Plastic;
 pub use specular::Mirror;
 
 use glam::{Vec2, Vec3};
@@ -82,6 +84,8 @@ pub enum Bxdf {
     Dielectric(Dielectric),
     /// A metal with a complex index, smooth or rough (GGX).
     Conductor(Conductor),
+    /// A dielectric coat over a diffuse base (coated diffuse).
+    Plastic(Plastic),
 }
 
 impl Bxdf {
@@ -92,6 +96,7 @@ impl Bxdf {
             Bxdf::Lambertian(m) => m.eval(wo, wi, lambdas),
             Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
             Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
+            Bxdf::Plastic(m) => m.eval(wo, wi, lambdas),
             Bxdf::Dielectric(m) => Sampled::splat(m.eval(wo, wi, m.eta_for(lambdas))),
             Bxdf::Black | Bxdf::Mirror(_) => Sampled::splat(0.0),
         }
@@ -108,6 +113,7 @@ impl Bxdf {
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
             Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas)),
             Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
+            Bxdf::Plastic(m) => m.sample(wo, u, uc, lambdas),
         }
     }
 
@@ -118,6 +124,7 @@ impl Bxdf {
         match self {
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
             Bxdf::Conductor(m) => m.pdf(wo, wi),
+            Bxdf::Plastic(m) => m.pdf(wo, wi, lambdas),
             Bxdf::Dielectric(m) => m.pdf(wo, wi, m.eta_for(lambdas)),
             Bxdf::Black | Bxdf::Mirror(_) => 0.0,
         }
@@ -130,7 +137,7 @@ impl Bxdf {
             Bxdf::Mirror(_) => true,
             Bxdf::Dielectric(d) => d.is_smooth(),
             Bxdf::Conductor(c) => c.is_smooth(),
-            Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => false,
+            Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) | Bxdf::Plastic(_) => false,
         }
     }
 

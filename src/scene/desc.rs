@@ -162,6 +162,17 @@ pub enum MaterialDesc {
         #[serde(default)]
         roughness: f32,
     },
+    /// Coated diffuse: a dielectric coat (index `ior`, GGX `roughness`,
+    /// default 0: smooth) over a Lambertian base of `reflectance`.
+    Plastic {
+        /// The base's diffuse reflectance.
+        reflectance: SpectrumDesc,
+        /// The coat's index of refraction.
+        ior: IorDesc,
+        /// GGX α of the coat in [0, 1] (default 0: smooth).
+        #[serde(default)]
+        roughness: f32,
+    },
     /// Absorbs everything.
     Black,
 }

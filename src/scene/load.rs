@@ -10,7 +10,7 @@ use glam::Vec3;
 use super::desc::{IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
 use super::{Object, Scene};
 use crate::bxdf::{
-    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, named_glass,
+    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, Plastic, named_glass,
     named_metal,
 };
 use crate::camera::Camera;
@@ -196,6 +196,23 @@ impl Ctx<'_> {
                     }
                 };
                 Bxdf::Conductor(Conductor { eta, k, alpha: self.roughness(&format!("{field}.roughness"), *roughness)? })
+            }
+            MaterialDesc::Plastic { reflectance, ior, roughness } => {
+                let ior = self.ior(&format!("{field}.ior"), ior)?;
+                for b in 0..N_BINS {
+                    let n = ior.at(color::bin_lambda_nm(b));
+                    if n < 1.0 {
+                        return Err(self.err(
+                            format!("{field}.ior"),
+                            format!("a coat's index must be at least 1, found {n} at {} nm", color::bin_lambda_nm(b)),
+                        ));
+                    }
+                }
+                Bxdf::Plastic(Plastic::new(
+                    self.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                    &ior,
+                    self.roughness(&format!("{field}.roughness"), *roughness)?,
+                ))
             }
             MaterialDesc::Black => Bxdf::Black,
         })
