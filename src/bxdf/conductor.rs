@@ -15,11 +15,17 @@
 //! "gold": Conductor(metal: "Au"),
 //! "rough_copper": Conductor(metal: "Cu", roughness: 0.2),
 //! "custom": Conductor(eta: Constant(0.2), k: Constant(3.0), roughness: 0.05),
+//! "tempered": Conductor(metal: "Cr", coating: ThinFilm(thickness_nm: 250, ior: Constant(2.2))),
 //! ```
+//!
+//! A `coating` replaces the bare Fresnel reflectance by the Airy reflectance
+//! of the film on the metal ([`super::thin_film`]), at the macro-surface
+//! (smooth) or microfacet (rough) angle.
 
 use glam::{Vec2, Vec3};
 
 use super::microfacet::{Ggx, SMOOTH_ALPHA};
+use super::thin_film::ThinFilm;
 use super::{BsdfSample, fresnel_conductor};
 use crate::color::{Sampled, Spectrum};
 use crate::spectral::Lambdas;
@@ -33,6 +39,8 @@ pub struct Conductor {
     pub k: Spectrum,
     /// GGX α; below [`SMOOTH_ALPHA`] the surface is smooth.
     pub alpha: f32,
+    /// An optional thin film on top (interference colours: oxide, oil).
+    pub coating: Option<ThinFilm>,
 }
 
 impl Conductor {
@@ -42,11 +50,15 @@ impl Conductor {
         !(self.alpha >= SMOOTH_ALPHA)
     }
 
-    /// The Fresnel reflectance at each of the packet's wavelengths for incidence cosine `cos`.
+    /// The Fresnel reflectance at each of the packet's wavelengths for
+    /// incidence cosine `cos` (through the coating's Airy sum when coated).
     #[inline]
     pub fn fresnel<const N: usize>(&self, cos: f32, lambdas: &Lambdas<N>) -> Sampled<N> {
         let (eta, k) = (lambdas.sample(&self.eta), lambdas.sample(&self.k));
-        Sampled(std::array::from_fn(|i| fresnel_conductor(cos, eta[i], k[i])))
+        match &self.coating {
+            Some(film) => film.airy(cos, &eta, &k, lambdas).0,
+            None => Sampled(std::array::from_fn(|i| fresnel_conductor(cos, eta[i], k[i]))),
+        }
     }
 
     /// `f(wo, wi)` (0 for the smooth model and across the surface).

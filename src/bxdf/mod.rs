@@ -37,6 +37,7 @@ mod rough_dielectric;
 mod specular;
 #[cfg(test)]
 mod tests;
+mod thin_film;
 
 pub use conductor::Conductor;
 pub use dielectric::Dielectric;
@@ -47,6 +48,7 @@ pub use metals::{NAMED_METALS, named_metal};
 pub use oren_nayar::OrenNayar;
 pub use plastic::Plastic;
 pub use specular::Mirror;
+pub use thin_film::{ThinFilm, ThinSheet, airy};
 
 use glam::{Vec2, Vec3};
 
@@ -86,6 +88,8 @@ pub enum Bxdf {
     Conductor(Conductor),
     /// A dielectric coat over a diffuse base (coated diffuse).
     Plastic(Plastic),
+    /// A free-standing thin film (soap film): interference reflection, straight transmission.
+    ThinSheet(ThinSheet),
 }
 
 impl Bxdf {
@@ -98,7 +102,7 @@ impl Bxdf {
             Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
             Bxdf::Plastic(m) => m.eval(wo, wi, lambdas),
             Bxdf::Dielectric(m) => Sampled::splat(m.eval(wo, wi, m.eta_for(lambdas))),
-            Bxdf::Black | Bxdf::Mirror(_) => Sampled::splat(0.0),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => Sampled::splat(0.0),
         }
     }
 
@@ -114,6 +118,7 @@ impl Bxdf {
             Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas)),
             Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
             Bxdf::Plastic(m) => m.sample(wo, u, uc, lambdas),
+            Bxdf::ThinSheet(m) => m.sample(wo, uc, lambdas),
         }
     }
 
@@ -126,7 +131,7 @@ impl Bxdf {
             Bxdf::Conductor(m) => m.pdf(wo, wi),
             Bxdf::Plastic(m) => m.pdf(wo, wi, lambdas),
             Bxdf::Dielectric(m) => m.pdf(wo, wi, m.eta_for(lambdas)),
-            Bxdf::Black | Bxdf::Mirror(_) => 0.0,
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => 0.0,
         }
     }
 
@@ -134,7 +139,7 @@ impl Bxdf {
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Bxdf::Mirror(_) => true,
+            Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => true,
             Bxdf::Dielectric(d) => d.is_smooth(),
             Bxdf::Conductor(c) => c.is_smooth(),
             Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) | Bxdf::Plastic(_) => false,

@@ -263,7 +263,7 @@ fn chi_square_rough_conductor() {
     let n = 100_000;
     let mut seed = 100;
     for alpha in alphas {
-        let b = Bxdf::Conductor(Conductor { eta, k, alpha });
+        let b = Bxdf::Conductor(Conductor { eta, k, alpha, coating: None });
         for theta in thetas {
             let t = theta.to_radians();
             let wo = Vec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos()).normalize();
@@ -323,10 +323,19 @@ fn all_models() -> Vec<(&'static str, Bxdf)> {
         ("Conductor Ag α=1", conductor("Ag", 1.0)),
         ("Plastic 1.5", Bxdf::Plastic(Plastic::new(rho, &Ior::Constant(1.5), 0.0))),
         ("Plastic N-SF11 α=0.2", Bxdf::Plastic(Plastic::new(rho, &named_glass("N-SF11").unwrap(), 0.2))),
+        ("Coated Cr", coated("Cr", 0.0, 300.0)),
+        ("Coated Au α=0.3", coated("Au", 0.3, 2000.0)),
+        ("ThinSheet 400 nm", Bxdf::ThinSheet(ThinSheet { film: ThinFilm::new(400.0, &Ior::Constant(1.33)) })),
         ("Rough glass 1.5 α=0.001", rough_glass(Ior::Constant(1.5), SMOOTH_ALPHA)),
         ("Rough glass 1.5 α=0.15", rough_glass(Ior::Constant(1.5), 0.15)),
         ("Rough N-SF11 α=0.5", rough_glass(named_glass("N-SF11").unwrap(), 0.5)),
     ]
+}
+
+fn coated(metal: &str, alpha: f32, thickness_nm: f32) -> Bxdf {
+    let (eta, k) = named_metal(metal).unwrap();
+    let coating = Some(ThinFilm::new(thickness_nm, &Ior::Constant(1.45)));
+    Bxdf::Conductor(Conductor { eta, k, alpha, coating })
 }
 
 fn rough_glass(ior: Ior, alpha: f32) -> Bxdf {
@@ -340,7 +349,7 @@ fn side_eta(w: Vec3, eta: f32) -> f32 {
 
 fn conductor(metal: &str, alpha: f32) -> Bxdf {
     let (eta, k) = named_metal(metal).unwrap();
-    Bxdf::Conductor(Conductor { eta, k, alpha })
+    Bxdf::Conductor(Conductor { eta, k, alpha, coating: None })
 }
 
 /// Incident cosines from normal to grazing, on both sides: down to 1e-6
@@ -397,8 +406,8 @@ fn every_model_conserves_energy_at_all_angles_and_wavelengths() {
     for (name, b) in all_models() {
         for &c in &COSINES {
             let wo = dir(c, 0.7);
-            if let Bxdf::Dielectric(_) = b {
-                continue; // exactly (smooth) and against an integral (rough), below
+            if let Bxdf::Dielectric(_) | Bxdf::ThinSheet(_) = b {
+                continue; // exactly (smooth, sheet) and against an integral (rough): below, thin_film.rs
             }
             let a = check_sample_consistency(&b, wo, 4000);
             for i in 0..N_BINS {
@@ -548,7 +557,7 @@ fn ggx_albedo_integral(alpha: f64, mu_o: f64) -> f64 {
 /// at α = 1 and normal incidence about 40%).
 #[test]
 fn rough_perfect_reflector_albedo_matches_the_integral() {
-    let white = |alpha| Bxdf::Conductor(Conductor { eta: Spectrum::ZERO, k: Spectrum::ONE, alpha });
+    let white = |alpha| Bxdf::Conductor(Conductor { eta: Spectrum::ZERO, k: Spectrum::ONE, alpha, coating: None });
     assert_eq!(fresnel_conductor(0.3, 0.0, 1.0), 1.0);
     let mut last = 1.0f64;
     for alpha in [0.1f32, 0.3, 0.6, 1.0] {

@@ -161,6 +161,9 @@ pub enum MaterialDesc {
         /// GGX α in [0, 1] (default 0: smooth).
         #[serde(default)]
         roughness: f32,
+        /// A thin film on the metal: `coating: ThinFilm(thickness_nm: 300, ior: Constant(1.45))`.
+        #[serde(default)]
+        coating: Option<CoatingDesc>,
     },
     /// Coated diffuse: a dielectric coat (index `ior`, GGX `roughness`,
     /// default 0: smooth) over a Lambertian base of `reflectance`.
@@ -173,8 +176,28 @@ pub enum MaterialDesc {
         #[serde(default)]
         roughness: f32,
     },
+    /// A free-standing thin film (soap film): `ThinSheet(thickness_nm: 400, ior: Constant(1.33))`.
+    ThinSheet {
+        /// Thickness in nm.
+        thickness_nm: f32,
+        /// The film's index of refraction.
+        ior: IorDesc,
+    },
     /// Absorbs everything.
     Black,
+}
+
+/// A coating on a surface.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CoatingDesc {
+    /// A thin film of `thickness_nm` and index `ior` (interference per wavelength).
+    ThinFilm {
+        /// Thickness in nm.
+        thickness_nm: f32,
+        /// The film's index of refraction.
+        ior: IorDesc,
+    },
 }
 
 /// A shape.

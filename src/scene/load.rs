@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::desc::{IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
+use super::desc::{CoatingDesc, IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
 use super::{Object, Scene};
 use crate::bxdf::{
-    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, Plastic, named_glass,
-    named_metal,
+    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, Plastic, ThinFilm,
+    ThinSheet, named_glass, named_metal,
 };
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
@@ -173,7 +173,7 @@ impl Ctx<'_> {
                 }
                 Bxdf::Dielectric(d)
             }
-            MaterialDesc::Conductor { metal, eta, k, roughness } => {
+            MaterialDesc::Conductor { metal, eta, k, roughness, coating } => {
                 let (eta, k) = match (metal, eta, k) {
                     (Some(name), None, None) => named_metal(name).ok_or_else(|| {
                         let names: Vec<&str> = NAMED_METALS.iter().map(|m| m.0).collect();
@@ -195,7 +195,14 @@ impl Ctx<'_> {
                         return Err(self.err(field, "expected either `metal: \"Au\"` or both `eta:` and `k:` spectra"));
                     }
                 };
-                Bxdf::Conductor(Conductor { eta, k, alpha: self.roughness(&format!("{field}.roughness"), *roughness)? })
+                let coating = match coating {
+                    None => None,
+                    Some(CoatingDesc::ThinFilm { thickness_nm, ior }) => {
+                        Some(self.thin_film(&format!("{field}.coating"), *thickness_nm, ior)?)
+                    }
+                };
+                let alpha = self.roughness(&format!("{field}.roughness"), *roughness)?;
+                Bxdf::Conductor(Conductor { eta, k, alpha, coating })
             }
             MaterialDesc::Plastic { reflectance, ior, roughness } => {
                 let ior = self.ior(&format!("{field}.ior"), ior)?;
@@ -214,8 +221,23 @@ impl Ctx<'_> {
                     self.roughness(&format!("{field}.roughness"), *roughness)?,
                 ))
             }
+            MaterialDesc::ThinSheet { thickness_nm, ior } => {
+                Bxdf::ThinSheet(ThinSheet { film: self.thin_film(field, *thickness_nm, ior)? })
+            }
             MaterialDesc::Black => Bxdf::Black,
         })
+    }
+
+    /// A thin film: a thickness in [0, 1e7] nm and an index of at least 1.
+    fn thin_film(&self, field: &str, thickness_nm: f32, ior: &IorDesc) -> Result<ThinFilm> {
+        if !(thickness_nm.is_finite() && (0.0..=1e7).contains(&thickness_nm)) {
+            return Err(self.err(
+                format!("{field}.thickness_nm"),
+                format!("expected a thickness in nm in [0, 1e7], found {thickness_nm}"),
+            ));
+        }
+        let ior = self.ior(&format!("{field}.ior"), ior)?;
+        Ok(ThinFilm::new(thickness_nm, &ior))
     }
 
     /// A GGX α: a number in [0, 1] (0 is smooth).
