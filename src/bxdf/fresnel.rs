@@ -37,7 +37,9 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 /// With `k = 0` it is the dielectric's reflectance for `eta ≥ 1`.
 #[inline]
 pub fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
-    let c = cos_i.abs().min(1.0);
+    // f64 inside: (n² − k²)² overflows f32 for indices above ~1e9.
+    let (eta, k) = (eta as f64, k as f64);
+    let c = (cos_i.abs() as f64).min(1.0);
     let c2 = c * c;
     let s2 = 1.0 - c2;
     let t = eta * eta - k * k - s2;
@@ -45,14 +47,15 @@ pub fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
     let a = (0.5 * (a2b2 + t)).max(0.0).sqrt();
     let rs_num = a2b2 - 2.0 * a * c + c2;
     let rs_den = a2b2 + 2.0 * a * c + c2;
-    if rs_den <= 0.0 {
+    if !(rs_den > 0.0) {
         return 1.0;
     }
     let rs = rs_num / rs_den;
     let p_num = c2 * a2b2 - 2.0 * a * s2 * c + s2 * s2;
     let p_den = c2 * a2b2 + 2.0 * a * s2 * c + s2 * s2;
     let rp = if p_den > 0.0 { rs * p_num / p_den } else { rs };
-    (0.5 * (rs + rp)).clamp(0.0, 1.0)
+    let r = 0.5 * (rs + rp);
+    if r.is_finite() { r.clamp(0.0, 1.0) as f32 } else { 1.0 }
 }
 
 /// Refracts `wi` (pointing away from the surface, on either side) through a

@@ -11,7 +11,7 @@
 //!
 //! where `F_dr = 2 ∫₀¹ F_inside(μ) μ dμ` is the coat's hemispherical
 //! reflectance from inside (total internal reflection included), computed per
-//! bin when the plastic is built. **Energy**: with `ρ = 1` and a smooth
+//! bin when the plastic is built through `η² (1 − F_dr) = 1 − F_dr,outside`. **Energy**: with `ρ = 1` and a smooth
 //! coat, the specular plus diffuse albedo is exactly 1 at every angle
 //! (because `η² (1 − F_dr) = 1 − F_dr,outside`); with `ρ < 1` it is
 //! `F(θo) + (1 − F(θo)) ρ (1 − F_dr,out) / (1 − ρ F_dr)` ≤ 1. A rough coat
@@ -50,14 +50,14 @@ pub struct Plastic {
     alpha: f32,
 }
 
-/// The hemispherical reflectance of an interface from the dense side,
-/// `2 ∫₀¹ F(−μ) μ dμ`, by the midpoint rule (1000 steps, error ~1e-6).
-pub fn internal_diffuse_reflectance(eta: f32) -> f32 {
+/// The hemispherical reflectance of an interface from the rare side,
+/// `2 ∫₀¹ F(μ) μ dμ`, by the midpoint rule (1000 steps).
+pub fn external_diffuse_reflectance(eta: f32) -> f32 {
     let n = 1000;
     (0..n)
         .map(|i| {
             let mu = (i as f32 + 0.5) / n as f32;
-            2.0 * fresnel_dielectric(-mu, eta) * mu / n as f32
+            2.0 * fresnel_dielectric(mu, eta) * mu / n as f32
         })
         .sum()
 }
@@ -68,7 +68,11 @@ impl Plastic {
         let eta = Spectrum::from_fn(|b| ior.at(bin_lambda_nm(b)).max(1e-3));
         let diffuse = Spectrum::from_fn(|b| {
             let (rho, e) = (reflectance[b], eta[b]);
-            rho * FRAC_1_PI / (e * e * (1.0 - rho * internal_diffuse_reflectance(e)))
+            // η² (1 − ρ F_dr,in) = η² (1 − ρ) + ρ (1 − F_dr,out) by the identity in the
+            // module docs: stable where F_dr,in → 1 (large η, white base).
+            let denom = e * e * (1.0 - rho) + rho * (1.0 - external_diffuse_reflectance(e));
+            let v = rho * FRAC_1_PI / denom;
+            if v.is_finite() && denom > 0.0 { v } else { 0.0 }
         });
         Plastic { reflectance, eta, diffuse, alpha }
     }
@@ -179,6 +183,18 @@ impl Plastic {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The hemispherical reflectance of an interface from the dense side,
+    /// `2 ∫₀¹ F(−μ) μ dμ`, by the midpoint rule (1000 steps, error ~1e-6).
+    fn internal_diffuse_reflectance(eta: f32) -> f32 {
+        let n = 1000;
+        (0..n)
+            .map(|i| {
+                let mu = (i as f32 + 0.5) / n as f32;
+                2.0 * fresnel_dielectric(-mu, eta) * mu / n as f32
+            })
+            .sum()
+    }
 
     /// `F_dr` from inside against the closed form for η = 1.5 obtained by
     /// the identity η² (1 − F_dr,in) = 1 − F_dr,out, with F_dr,out
