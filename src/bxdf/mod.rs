@@ -115,7 +115,7 @@ impl Bxdf {
             Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
-            Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas)),
+            Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas), lambdas),
             Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
             Bxdf::Plastic(m) => m.sample(wo, u, uc, lambdas),
             Bxdf::ThinSheet(m) => m.sample(wo, uc, lambdas),
@@ -207,6 +207,23 @@ impl Dispersion<'_> {
     #[inline]
     pub fn eta_at(&self, pos: f32) -> f32 {
         self.0.eta_at(pos)
+    }
+
+    /// The reflectance at incidence cosine `cos` for the bin at fractional
+    /// position `pos`, at that bin's index (the film's where the glass is coated).
+    #[inline]
+    pub fn reflectance_at(&self, cos: f32, pos: f32) -> f32 {
+        self.0.reflectance_at(cos, self.0.eta_at(pos), pos)
+    }
+
+    /// The reflectance at the reference wavelength (589.3 nm) for incidence cosine `cos`.
+    #[inline]
+    pub fn reference_reflectance(&self, cos: f32) -> f32 {
+        self.0.reflectance_at(
+            cos,
+            self.0.reference_eta(),
+            (crate::spectral::REFERENCE_LAMBDA_NM - crate::color::LAMBDA_MIN_NM) / crate::color::LAMBDA_STEP_NM,
+        )
     }
 
     /// The reflectance at each of the packet's wavelengths for `wo`.

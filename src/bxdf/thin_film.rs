@@ -136,6 +136,14 @@ impl ThinFilm {
         ThinFilm { thickness_nm, eta: Spectrum::from_fn(|b| ior.at(bin_lambda_nm(b))) }
     }
 
+    /// The film's index at fractional bin position `pos`.
+    #[inline]
+    pub fn eta_at(&self, pos: f32) -> f32 {
+        let i0 = (pos.max(0.0) as usize).min(35);
+        let frac = pos - i0 as f32;
+        if frac <= 0.0 || i0 + 1 >= 36 { self.eta[i0] } else { self.eta[i0] * (1.0 - frac) + self.eta[i0 + 1] * frac }
+    }
+
     /// Reflectance and transmittance per wavelength of the packet, from vacuum,
     /// onto a substrate of index `n_t + i k_t` (per wavelength).
     #[inline]
@@ -281,6 +289,37 @@ mod tests {
                 let wr = refl.f[b] * refl.wi.z.abs();
                 let wt = tr.f[b] * tr.wi.z.abs();
                 assert!((wr - r).abs() < 1e-5 && (wr + wt - 1.0).abs() < 1e-5, "cos {c} bin {b}");
+            }
+        }
+    }
+
+    /// Coated smooth glass (100 nm of n 1.38 on index 1.5, and a 1e6 nm
+    /// film): per wavelength, from outside and inside, R is the Airy
+    /// reflectance with the media in the right order, and R + T = 1 (the
+    /// two branches' weights, refraction's 1/η² undone); beyond the critical
+    /// angle from inside everything reflects.
+    #[test]
+    fn coated_glass_reflects_airy_and_conserves_energy() {
+        use crate::bxdf::Dielectric;
+        for d in [100.0f32, 1e6] {
+            let glass = Dielectric::new(Ior::Constant(1.5)).with_coating(ThinFilm::new(d, &Ior::Constant(1.38)));
+            let l = Lambdas::full();
+            for c in [1.0f32, 0.5, 0.05, -0.9, -0.8, -0.5] {
+                let wo = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
+                let refl: BsdfSample<36> = glass.sample_any(wo, glam::Vec2::ZERO, 0.0, 1.5, &l).unwrap();
+                let tr: BsdfSample<36> = glass.sample_any(wo, glam::Vec2::ZERO, 1.0 - 1e-7, 1.5, &l).unwrap();
+                for b in 0..36 {
+                    let (ni, nt) = if c > 0.0 { (1.0, 1.5) } else { (1.5, 1.0) };
+                    let (r, _) = airy(c, ni, 1.38, d, nt, 0.0, bin_lambda_nm(b));
+                    let wr = refl.f[b] * refl.wi.z.abs() / refl.pdf * refl.pdf;
+                    assert!((wr - r).abs() < 1e-5, "d {d} cos {c} bin {b}: {wr} vs {r}");
+                    if tr.wi.z * wo.z < 0.0 {
+                        let wt = tr.f[b] * tr.wi.z.abs() * tr.eta * tr.eta;
+                        assert!((wr + wt - 1.0).abs() < 1e-4, "d {d} cos {c} bin {b}: R + T = {}", wr + wt);
+                    } else {
+                        assert!(c < 0.0 && c > -0.75 && (r - 1.0).abs() < 1e-6, "TIR only beyond the critical angle");
+                    }
+                }
             }
         }
     }

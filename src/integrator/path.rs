@@ -24,7 +24,7 @@
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
-use crate::bxdf::{BsdfSample, Dispersion, fresnel_dielectric};
+use crate::bxdf::{BsdfSample, Dispersion};
 use crate::color::{N_BINS, Sampled, Xyz};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
@@ -251,7 +251,7 @@ impl PathTracer {
         let importance = bin_importance();
         let cos = sh.wo.z;
         let (p_reflect, all_fr) = if cos > 0.0 && glass.reference_eta() >= 1.0 {
-            (fresnel_dielectric(cos, glass.reference_eta()), None)
+            (glass.reference_reflectance(cos), None)
         } else {
             let fr = glass.reflectance(sh.wo, lambdas);
             let (mut total, mut reflected) = (0.0f32, 0.0f32);
@@ -275,7 +275,7 @@ impl PathTracer {
         for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
             let fr = match all_fr {
                 Some(fr) => fr[bin],
-                None => fresnel_dielectric(cos, glass.eta_at(lambdas.pos[bin])),
+                None => glass.reflectance_at(cos, lambdas.pos[bin]),
             };
             let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };

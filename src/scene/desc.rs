@@ -144,6 +144,9 @@ pub enum MaterialDesc {
         /// Absorption coefficient inside, per scene unit (default: clear).
         #[serde(default)]
         absorption: Option<SpectrumDesc>,
+        /// A thin film on the outside (smooth glass only): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
+        #[serde(default)]
+        coating: Option<CoatingDesc>,
     },
     /// A metal: `Conductor(metal: "Au")` (Au, Ag, Cu, Al, Cr, CuZn) or
     /// `Conductor(eta: SPECTRUM, k: SPECTRUM)`, optionally `roughness: A`

@@ -165,11 +165,20 @@ impl Ctx<'_> {
             MaterialDesc::Mirror { reflectance } => {
                 Bxdf::Mirror(Mirror { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
             }
-            MaterialDesc::Dielectric { ior, roughness, absorption } => {
+            MaterialDesc::Dielectric { ior, roughness, absorption, coating } => {
                 let mut d = Dielectric::new(self.ior(&format!("{field}.ior"), ior)?)
                     .with_roughness(self.roughness(&format!("{field}.roughness"), *roughness)?);
                 if let Some(a) = absorption {
                     d = d.with_absorption(self.spectrum(&format!("{field}.absorption"), a)?);
+                }
+                if let Some(CoatingDesc::ThinFilm { thickness_nm, ior }) = coating {
+                    if !d.is_smooth() {
+                        return Err(self.err(
+                            format!("{field}.coating"),
+                            "a coating is supported on smooth glass only (roughness below 0.001)",
+                        ));
+                    }
+                    d = d.with_coating(self.thin_film(&format!("{field}.coating"), *thickness_nm, ior)?);
                 }
                 Bxdf::Dielectric(d)
             }
