@@ -47,7 +47,7 @@ impl Conductor {
     /// True when the surface is the smooth (delta) model.
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        !(self.alpha >= SMOOTH_ALPHA)
+        self.alpha.is_nan() || self.alpha < SMOOTH_ALPHA
     }
 
     /// The Fresnel reflectance at each of the packet's wavelengths for
@@ -120,7 +120,7 @@ impl Conductor {
         let wi = if flip { -wi_up } else { wi_up };
         let f = self.eval(wo, wi, lambdas);
         let pdf = self.pdf(wo, wi);
-        if !(pdf > 0.0) || f.has_nan_or_inf() {
+        if pdf.is_nan() || pdf <= 0.0 || f.has_nan_or_inf() {
             return None;
         }
         Some(BsdfSample { wi, f, pdf, is_delta: false, eta: 1.0 })

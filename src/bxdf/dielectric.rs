@@ -115,7 +115,7 @@ impl Dielectric {
     /// True when the interface is smooth (a delta model).
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        !(self.alpha >= SMOOTH_ALPHA)
+        self.alpha.is_nan() || self.alpha < SMOOTH_ALPHA
     }
 
     /// The absorption coefficient inside, when the glass absorbs.
@@ -212,7 +212,7 @@ impl Dielectric {
         let p = (r.0.iter().sum::<f32>() / N as f32).clamp(0.0, 1.0);
         let refracted = refract(wo, Vec3::Z, eta);
         if uc < p || p >= 1.0 || refracted.is_none() {
-            if !(p > 0.0) {
+            if p.is_nan() || p <= 0.0 {
                 return None;
             }
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);

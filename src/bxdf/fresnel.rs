@@ -47,7 +47,7 @@ pub fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
     let a = (0.5 * (a2b2 + t)).max(0.0).sqrt();
     let rs_num = a2b2 - 2.0 * a * c + c2;
     let rs_den = a2b2 + 2.0 * a * c + c2;
-    if !(rs_den > 0.0) {
+    if rs_den.is_nan() || rs_den <= 0.0 {
         return 1.0;
     }
     let rs = rs_num / rs_den;

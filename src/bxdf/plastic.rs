@@ -85,7 +85,7 @@ impl Plastic {
     /// True for a smooth coat (its reflection is a delta lobe).
     #[inline]
     fn is_smooth(&self) -> bool {
-        !(self.alpha >= SMOOTH_ALPHA)
+        self.alpha.is_nan() || self.alpha < SMOOTH_ALPHA
     }
 
     /// The coat's reflectance averaged over the packet: the probability of
@@ -173,7 +173,7 @@ impl Plastic {
         }
         let wi = if flip { -wi_up } else { wi_up };
         let (f, pdf) = (self.eval(wo, wi, lambdas), self.pdf(wo, wi, lambdas));
-        if !(pdf > 0.0) || f.has_nan_or_inf() {
+        if pdf.is_nan() || pdf <= 0.0 || f.has_nan_or_inf() {
             return None;
         }
         Some(BsdfSample { wi, f, pdf, is_delta: false, eta: 1.0 })
