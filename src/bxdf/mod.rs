@@ -37,6 +37,8 @@ mod rough_dielectric;
 mod specular;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_rough;
 mod thin_film;
 
 pub use conductor::Conductor;
