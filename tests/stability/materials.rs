@@ -237,3 +237,31 @@ fn coated_glass_is_invisible_in_a_furnace() {
         assert!((mean - 1.0).abs() < 5.0 * se + 5e-3, "{m}: {mean} ± {se}");
     }
 }
+
+/// A white plastic (ρ = 1 under a smooth coat of n 1.5) conserves energy
+/// exactly (plastic.rs: F(θo) plus the diffuse albedo is 1 at every angle),
+/// so a sphere of it in the uniform enclosure is invisible for every method
+/// that follows all bounces; image mean within 5 s.e. + 0.5%. `whitted`
+/// ends at the plastic with direct light only and misses the coat's mirror
+/// lobe (documented shortfall): at most 1 within 5 s.e.
+#[test]
+fn white_plastic_is_invisible_in_a_furnace() {
+    let scene = format!(
+        r#"(
+        camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40),
+        render: (width: 8, height: 8, max_bounces: 10000),
+        materials: {{ "p": Plastic(reflectance: Constant(1), ior: Constant(1.5)) }},
+        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "p"), {ENCLOSURE} ],
+    )"#
+    );
+    for m in METHODS {
+        let film = render_str(&scene, &method(m, 32, 29));
+        let (mean, se) = mean_and_stderr(&film, 1);
+        eprintln!("white plastic in a furnace, {m}: Y = {mean:.4} ± {se:.4}, want 1");
+        if m == "whitted" {
+            assert!(mean <= 1.0 + 5.0 * se, "{m}: {mean} ± {se}");
+        } else {
+            assert!((mean - 1.0).abs() < 5.0 * se + 5e-3, "{m}: {mean} ± {se}");
+        }
+    }
+}
