@@ -20,8 +20,8 @@
 //!   reference wavelength, 589.3 nm (only `path` and `whitted`, which do not
 //!   split, let one reach a dispersive surface).
 //!
-//! Diffuse models are two-sided: they reflect into whichever hemisphere `wo`
-//! is in. The dielectric is oriented: `+z` is outside (the side the geometric
+//! Diffuse models, conductors and plastic are two-sided: they reflect into
+//! whichever hemisphere `wo` is in; a thin sheet is symmetric. The dielectric is oriented: `+z` is outside (the side the geometric
 //! normal points to), so `wo.z < 0` means the path is inside the glass.
 
 mod conductor;
