@@ -30,6 +30,11 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// The eye's position.
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
     /// A camera at `eye` looking at `look_at`; `up` need not be orthogonal to
     /// the view direction, only not parallel to it (checked by the scene loader).
     pub fn new(eye: Vec3, look_at: Vec3, up: Vec3, fov_deg: f32, width: u32, height: u32) -> Self {

@@ -21,6 +21,11 @@
 //! | H | header: bincode (standard config) of the writer's crate version, the scene file's absolute path and content hash, all [`Settings`], the pass range held, the target pass, the output path |
 //! | P | payload: lz4_flex block (size prepended) of bincode of the film: width, height and 3 fixed-point `i128` sums per pixel |
 //!
+//! A spectral film (`--spectral`) is written as version 2 ([`SPECTRAL_FORMAT_VERSION`]): the
+//! same layout, its payload followed (inside the same lz4 block) by `width × height × 36`
+//! fixed-point per-bin sums. Colour-only films are written as version 1 exactly as before;
+//! both versions are read.
+//!
 //! Reading checks the magic, the version, the exact length (a truncated
 //! file is reported as such), the checksum, then decodes and validates every
 //! field; any failure is an [`Error::Checkpoint`] naming the file. Writing
@@ -32,6 +37,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::color::N_BINS;
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::io::Fnv1a;
@@ -41,8 +47,13 @@ use crate::settings::Settings;
 /// The first 8 bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"RUSTVCKP";
 
-/// The format version this build writes and reads.
+/// The format version this build writes for colour-only films, and reads.
 pub const FORMAT_VERSION: u32 = 1;
+
+/// The format version of a spectral film's checkpoint (`--spectral`): version 1 whose payload
+/// also holds 36 fixed-point per-bin sums per pixel after the XYZ sums. Colour-only renders
+/// keep writing version 1, so their checkpoints stay as small and as readable as before.
+pub const SPECTRAL_FORMAT_VERSION: u32 = 2;
 
 /// Bytes before the header: magic, version, two lengths, checksum.
 const PREFIX_LEN: usize = 32;
@@ -97,6 +108,23 @@ struct Payload {
     sums: Vec<[i128; 3]>,
 }
 
+#[derive(Serialize)]
+struct SpectralPayloadRef<'a> {
+    width: u32,
+    height: u32,
+    sums: &'a [[i128; 3]],
+    /// Pixel-major, 36 bins per pixel (serde has no 36-element arrays).
+    spectral: &'a [i128],
+}
+
+#[derive(Deserialize)]
+struct SpectralPayload {
+    width: u32,
+    height: u32,
+    sums: Vec<[i128; 3]>,
+    spectral: Vec<i128>,
+}
+
 /// FNV-1a 64-bit over several byte strings in turn.
 fn checksum(parts: &[&[u8]]) -> u64 {
     let mut h = Fnv1a::default();
@@ -147,12 +175,21 @@ impl Checkpoint {
         let encode_error =
             |e: bincode::error::EncodeError| Error::checkpoint(&self.output, format!("cannot encode: {e}"));
         let header = bincode::serde::encode_to_vec(&header, config).map_err(encode_error)?;
-        let payload = PayloadRef { width: film.width(), height: film.height(), sums: film.sums() };
-        let payload =
-            lz4_flex::compress_prepend_size(&bincode::serde::encode_to_vec(&payload, config).map_err(encode_error)?);
+        let (width, height, sums) = (film.width(), film.height(), film.sums());
+        let (version, raw) = match film.spectral_sums() {
+            None => (FORMAT_VERSION, bincode::serde::encode_to_vec(PayloadRef { width, height, sums }, config)),
+            Some(spectral) => (
+                SPECTRAL_FORMAT_VERSION,
+                bincode::serde::encode_to_vec(
+                    SpectralPayloadRef { width, height, sums, spectral: spectral.as_flattened() },
+                    config,
+                ),
+            ),
+        };
+        let payload = lz4_flex::compress_prepend_size(&raw.map_err(encode_error)?);
         let mut out = Vec::with_capacity(PREFIX_LEN + header.len() + payload.len());
         out.extend_from_slice(&MAGIC);
-        out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&version.to_le_bytes());
         out.extend_from_slice(&(header.len() as u32).to_le_bytes());
         out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
         out.extend_from_slice(&checksum(&[&header, &payload]).to_le_bytes());
@@ -174,12 +211,13 @@ impl Checkpoint {
             return Err(bad(format!("truncated: {} bytes, the fixed header alone is {PREFIX_LEN}", bytes.len())));
         }
         let version = u32_at(bytes, 8);
-        if version != FORMAT_VERSION {
+        if version != FORMAT_VERSION && version != SPECTRAL_FORMAT_VERSION {
             return Err(bad(format!(
-                "format version {version}; this rust-v ({}) reads version {FORMAT_VERSION}",
+                "format version {version}; this rust-v ({}) reads versions {FORMAT_VERSION} and {SPECTRAL_FORMAT_VERSION}",
                 env!("CARGO_PKG_VERSION")
             )));
         }
+        let spectral = version == SPECTRAL_FORMAT_VERSION;
         let header_len = u32_at(bytes, 12);
         let payload_len = u64_at(bytes, 16);
         if header_len > MAX_HEADER_LEN {
@@ -210,8 +248,8 @@ impl Checkpoint {
             return Err(bad("corrupt header: trailing bytes".into()));
         }
         let settings = h.settings;
-        if let Err((field, message)) = (Settings { spp: settings.spp.max(1), ..settings.clone() }).check() {
-            return Err(bad(format!("corrupt header: {field}: {message}")));
+        if let Err(e) = settings.check() {
+            return Err(bad(format!("corrupt header: {e}")));
         }
         if h.end_pass < h.first_pass {
             return Err(bad("corrupt header: invalid pass range".into()));
@@ -220,19 +258,34 @@ impl Checkpoint {
         // The decompressed size is prepended; bound it by what the film can need
         // (17 bytes per varint i128) before allocating.
         let pixels = settings.width as u64 * settings.height as u64;
-        let limit = pixels * 3 * 17 + 64;
+        let limit = pixels * if spectral { 3 + N_BINS as u64 } else { 3 } * 17 + 64;
         if payload_bytes.len() < 4 || u32_at(payload_bytes, 0) as u64 > limit {
             return Err(bad("corrupt payload: implausible size".into()));
         }
         let raw = lz4_flex::decompress_size_prepended(payload_bytes)
             .map_err(|e| bad(format!("corrupt payload: does not decompress: {e}")))?;
-        let (p, used): (Payload, usize) =
-            bincode::serde::decode_from_slice(&raw, config).map_err(|e| bad(format!("corrupt payload: {e}")))?;
+        let corrupt = |e: bincode::error::DecodeError| bad(format!("corrupt payload: {e}"));
+        let (p, spectral_sums, used) = if spectral {
+            let (p, used): (SpectralPayload, usize) =
+                bincode::serde::decode_from_slice(&raw, config).map_err(corrupt)?;
+            if p.spectral.len() != p.sums.len() * N_BINS {
+                return Err(bad("corrupt payload: spectral sums do not match the size".into()));
+            }
+            let bins: Vec<[i128; N_BINS]> =
+                p.spectral.chunks_exact(N_BINS).map(|c| std::array::from_fn(|b| c[b])).collect();
+            (Payload { width: p.width, height: p.height, sums: p.sums }, Some(bins), used)
+        } else {
+            let (p, used): (Payload, usize) = bincode::serde::decode_from_slice(&raw, config).map_err(corrupt)?;
+            (p, None, used)
+        };
         if used != raw.len() || (p.width, p.height) != (settings.width, settings.height) {
             return Err(bad("corrupt payload: size does not match the header".into()));
         }
-        let film = Film::from_parts(p.width, p.height, h.first_pass..h.end_pass, p.sums)
+        let mut film = Film::from_parts(p.width, p.height, h.first_pass..h.end_pass, p.sums)
             .map_err(|e| bad(format!("corrupt payload: {e}")))?;
+        if let Some(s) = spectral_sums {
+            film = film.with_spectral_sums(s).map_err(|e| bad(format!("corrupt payload: {e}")))?;
+        }
         Ok(Checkpoint {
             crate_version: h.crate_version,
             scene_path: h.scene_path,
@@ -259,7 +312,7 @@ impl Checkpoint {
 
     /// Reads and verifies a checkpoint file.
     pub fn read(path: &Path) -> Result<Checkpoint> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bytes = crate::io::read_input(path)?;
         Checkpoint::decode(&bytes, path)
     }
 

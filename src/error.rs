@@ -52,6 +52,14 @@ pub enum Error {
     },
     /// Invalid settings (command line or scene), e.g. a zero width.
     Settings(String),
+    /// One render setting out of range or unreadable; the caller says where
+    /// it came from (`render.width` in a scene, `--width` on the command line).
+    Setting {
+        /// The setting's name (`width`).
+        name: &'static str,
+        /// What is wrong and what was expected.
+        message: String,
+    },
     /// Two things that must agree do not (films of different sizes, pass
     /// ranges that do not follow each other); the caller names the file.
     Mismatch(String),
@@ -97,6 +105,7 @@ impl fmt::Display for Error {
             Error::Image { path, message } => write!(f, "image {}: {}", path.display(), message),
             Error::Checkpoint { path, message } => write!(f, "checkpoint {}: {}", path.display(), message),
             Error::Settings(message) | Error::Mismatch(message) => write!(f, "{message}"),
+            Error::Setting { name, message } => write!(f, "{name}: {message}"),
         }
     }
 }

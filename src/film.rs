@@ -3,7 +3,9 @@
 //!
 //! The film stores what the output needs and nothing more: three sums per
 //! pixel (XYZ, not 36 floats), because every integrator reduces a sample to
-//! XYZ before it reaches the film. It also records which passes it holds, a
+//! XYZ before it reaches the film; only a spectral film (`--spectral`,
+//! [`Film::new_spectral`]) also sums each sample's 36 bins, in the same fixed
+//! point, for the spectral EXR channels. It also records which passes it holds, a
 //! contiguous range `[first, first + passes)`, so that checkpoints can be
 //! resumed and films of disjoint pass ranges merged.
 //!
@@ -32,14 +34,15 @@
 //!   out-of-gamut values become 0; values above 1 become 1: no tone mapping,
 //!   no exposure) and encoded with the sRGB transfer curve.
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
-//!   unclamped, for measurements.
+//!   unclamped, for measurements; or Rec. 2020, ACEScg or XYZ when the film's
+//!   [`ColorSpace`] says so (`--color-space`).
 
 use std::ops::Range;
 use std::path::Path;
 
-use crate::color::{Xyz, xyz_to_linear_srgb_f64};
+use crate::color::{ColorSpace, N_BINS, Spectrum, Xyz, bin_lambda_nm, xyz_to_linear_srgb_f64};
 use crate::error::{Error, Result};
-use crate::io::image::write_linear_srgb;
+use crate::io::image::{is_exr, write_exr, write_exr_in, write_linear_srgb};
 
 /// Fractional bits of the fixed-point sums.
 pub const FRAC_BITS: u32 = 64;
@@ -130,12 +133,96 @@ pub struct Film {
     first_pass: u32,
     /// Passes (samples per pixel) summed so far.
     passes: u32,
+    /// The colour space of EXR output (an output choice: not stored in checkpoints).
+    color_space: ColorSpace,
+    /// Row-major per-bin radiance sums (fixed point like `sums`), when the film is spectral
+    /// (`--spectral`): 36 more sums per pixel, whose colour integral is `sums`.
+    spectral: Option<Vec<[i128; N_BINS]>>,
+}
+
+/// One camera sample as the film takes it: its XYZ and, for a spectral film, its per-bin
+/// radiance.
+pub(crate) trait FilmSample: Copy + Send + Sync {
+    /// The sample's XYZ.
+    fn xyz(&self) -> Xyz;
+    /// The sample's per-bin radiance, if it has one.
+    fn bins(&self) -> Option<&Spectrum>;
+}
+
+impl FilmSample for Xyz {
+    #[inline]
+    fn xyz(&self) -> Xyz {
+        *self
+    }
+    #[inline]
+    fn bins(&self) -> Option<&Spectrum> {
+        None
+    }
+}
+
+impl FilmSample for Spectrum {
+    #[inline]
+    fn xyz(&self) -> Xyz {
+        self.to_xyz()
+    }
+    #[inline]
+    fn bins(&self) -> Option<&Spectrum> {
+        Some(self)
+    }
 }
 
 impl Film {
     /// An empty film (its pass range starts where the first render starts).
     pub fn new(width: u32, height: u32) -> Self {
-        Film { width, height, sums: vec![[0; 3]; width as usize * height as usize], first_pass: 0, passes: 0 }
+        Film {
+            width,
+            height,
+            sums: vec![[0; 3]; width as usize * height as usize],
+            first_pass: 0,
+            passes: 0,
+            color_space: ColorSpace::Srgb,
+            spectral: None,
+        }
+    }
+
+    /// An empty spectral film: it also sums each sample's 36 bins (`--spectral`).
+    pub fn new_spectral(width: u32, height: u32, first_pass: u32) -> Self {
+        let n = width as usize * height as usize;
+        Film { spectral: Some(vec![[0; N_BINS]; n]), ..Film::starting_at(width, height, first_pass) }
+    }
+
+    /// The per-bin sums of a spectral film (row-major, fixed point), or `None`.
+    pub fn spectral_sums(&self) -> Option<&[[i128; N_BINS]]> {
+        self.spectral.as_deref()
+    }
+
+    /// Adds stored per-bin sums (a checkpoint of a spectral film), checked like
+    /// [`Film::from_parts`] checks the XYZ sums.
+    pub fn with_spectral_sums(mut self, sums: Vec<[i128; N_BINS]>) -> Result<Self> {
+        if sums.len() != self.sums.len() {
+            return Err(Error::Mismatch(format!("{} spectral sums for {} pixels", sums.len(), self.sums.len())));
+        }
+        let bound = to_fixed(MAX_SAMPLE) * self.passes as i128;
+        if let Some(i) = sums.iter().position(|s| s.iter().any(|v| v.unsigned_abs() > bound.unsigned_abs())) {
+            return Err(Error::Mismatch(format!(
+                "pixel {i} holds a spectral sum out of range for {} passes",
+                self.passes
+            )));
+        }
+        self.spectral = Some(sums);
+        Ok(self)
+    }
+
+    /// The most memory a render of a `width` x `height` film takes at once,
+    /// in bytes: the film's sums (48 bytes a pixel), a batch's sample
+    /// buffers (12 bytes a pixel a pass), and a checkpoint being encoded
+    /// (up to 51 bytes a pixel, twice: bincode, then lz4); a spectral film
+    /// adds 36 sums (576 bytes), 36 floats of samples (144) and their
+    /// encoding (up to 612, twice). Renders refuse sizes this machine cannot
+    /// hold before allocating anything.
+    pub fn bytes_needed(width: u32, height: u32, spectral: bool) -> u64 {
+        let per_pixel = 48 + 12 + 2 * 51 + if spectral { 576 + 144 + 2 * 612 } else { 0 };
+        width as u64 * height as u64 * per_pixel
     }
 
     /// An empty film whose first pass will be `first_pass` (a render of a
@@ -160,7 +247,25 @@ impl Film {
         if let Some(i) = sums.iter().position(|s| s.iter().any(|v| v.unsigned_abs() > bound.unsigned_abs())) {
             return Err(Error::Mismatch(format!("pixel {i} holds a sum out of range for {n} passes")));
         }
-        Ok(Film { width, height, sums, first_pass: passes.start, passes: n })
+        Ok(Film {
+            width,
+            height,
+            sums,
+            first_pass: passes.start,
+            passes: n,
+            color_space: ColorSpace::Srgb,
+            spectral: None,
+        })
+    }
+
+    /// Sets the colour space of EXR output (PNG output is always sRGB).
+    pub fn set_color_space(&mut self, space: ColorSpace) {
+        self.color_space = space;
+    }
+
+    /// The colour space of EXR output.
+    pub fn color_space(&self) -> ColorSpace {
+        self.color_space
     }
 
     /// Width in pixels.
@@ -206,8 +311,8 @@ impl Film {
     /// whole batches with [`Film::add_tiles_parallel`]; this is the tests'
     /// tile-by-tile reference.)
     #[cfg(test)]
-    pub(crate) fn add_tile(&mut self, tile: &Tile, samples: &[Xyz]) -> usize {
-        add_tile_to_rows(&mut self.sums, self.width, 0, tile, samples)
+    pub(crate) fn add_tile<S: FilmSample>(&mut self, tile: &Tile, samples: &[S]) -> usize {
+        add_tile_to_rows(&mut self.sums, self.spectral.as_deref_mut(), self.width, 0, tile, samples)
     }
 
     /// Adds whole passes of samples of `tiles` (row-major tiles of edge
@@ -218,29 +323,40 @@ impl Film {
     /// on the order of the additions, so the sums are those of adding tile by
     /// tile, pass by pass. The caller records the passes with `end_pass`.
     /// Returns the invalid samples.
-    pub(crate) fn add_tiles_parallel(&mut self, tiles: &[Tile], samples: &[Vec<Xyz>], tile_size: u32) -> usize {
+    pub(crate) fn add_tiles_parallel<S: FilmSample>(
+        &mut self,
+        tiles: &[Tile],
+        samples: &[Vec<S>],
+        tile_size: u32,
+    ) -> usize {
         use rayon::prelude::*;
         assert!(!tiles.is_empty() && samples.len().is_multiple_of(tiles.len()), "samples must hold whole passes");
         let width = self.width;
         let tiles_x = width.div_ceil(tile_size).max(1) as usize;
         let band_len = width as usize * tile_size as usize;
-        self.sums
-            .par_chunks_mut(band_len)
-            .enumerate()
-            .map(|(band, rows)| {
-                let first_row = band as u32 * tile_size;
-                let band_tiles = band * tiles_x..((band + 1) * tiles_x).min(tiles.len());
-                samples
-                    .chunks(tiles.len())
-                    .map(|pass| {
-                        band_tiles
-                            .clone()
-                            .map(|k| add_tile_to_rows(rows, width, first_row, &tiles[k], &pass[k]))
-                            .sum::<usize>()
-                    })
-                    .sum::<usize>()
-            })
-            .sum()
+        let add_band = |band: usize, rows: &mut [[i128; 3]], mut spec: Option<&mut [[i128; N_BINS]]>| {
+            let first_row = band as u32 * tile_size;
+            let band_tiles = band * tiles_x..((band + 1) * tiles_x).min(tiles.len());
+            samples
+                .chunks(tiles.len())
+                .map(|pass| {
+                    band_tiles
+                        .clone()
+                        .map(|k| add_tile_to_rows(rows, spec.as_deref_mut(), width, first_row, &tiles[k], &pass[k]))
+                        .sum::<usize>()
+                })
+                .sum::<usize>()
+        };
+        match self.spectral.as_mut() {
+            None => self.sums.par_chunks_mut(band_len).enumerate().map(|(band, rows)| add_band(band, rows, None)).sum(),
+            Some(spectral) => self
+                .sums
+                .par_chunks_mut(band_len)
+                .zip(spectral.par_chunks_mut(band_len))
+                .enumerate()
+                .map(|(band, (rows, spec))| add_band(band, rows, Some(spec)))
+                .sum(),
+        }
     }
 
     /// Adds the passes of `other`, which must be the same size and hold the
@@ -262,8 +378,18 @@ impl Film {
                 b.start, b.end, a.start, a.end
             )));
         }
+        if self.spectral.is_some() != other.spectral.is_some() {
+            return Err(Error::Mismatch("a spectral film (--spectral) cannot be merged with a colour-only one".into()));
+        }
         let passes =
             self.passes.checked_add(other.passes).ok_or_else(|| Error::Mismatch("more than 2^32 passes".into()))?;
+        if let (Some(mine), Some(theirs)) = (self.spectral.as_mut(), other.spectral.as_ref()) {
+            for (s, o) in mine.iter_mut().zip(theirs) {
+                for b in 0..N_BINS {
+                    s[b] = s[b].checked_add(o[b]).ok_or_else(|| Error::Mismatch("a pixel sum overflows".into()))?;
+                }
+            }
+        }
         for (s, o) in self.sums.iter_mut().zip(&other.sums) {
             for c in 0..3 {
                 s[c] = s[c].checked_add(o[c]).ok_or_else(|| Error::Mismatch("a pixel sum overflows".into()))?;
@@ -284,9 +410,20 @@ impl Film {
         self.mean_xyz().into_iter().map(xyz_to_linear_srgb_f64).collect()
     }
 
-    /// Writes the image: linear EXR if `path` ends in `.exr`, else 16-bit sRGB PNG
-    /// ([`crate::io::image::write_linear_srgb`]), atomically.
+    /// Writes the image: linear EXR if `path` ends in `.exr` (in the film's colour space), else
+    /// 16-bit sRGB PNG ([`crate::io::image::write_linear_srgb`]), atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
+        if is_exr(path) && (self.color_space != ColorSpace::Srgb || self.spectral.is_some()) {
+            let pixels: Vec<[f64; 3]> = self.mean_xyz().into_iter().map(|p| self.color_space.from_xyz(p)).collect();
+            let Some(spectral) = &self.spectral else {
+                return write_exr_in(path, self.width, self.height, &pixels, self.color_space);
+            };
+            let inv = if self.passes == 0 { 0.0 } else { 1.0 / self.passes as f64 };
+            let bins: Vec<Vec<f32>> =
+                (0..N_BINS).map(|b| spectral.iter().map(|s| (from_fixed(s[b]) * inv) as f32).collect()).collect();
+            let wavelengths: Vec<f32> = (0..N_BINS).map(bin_lambda_nm).collect();
+            return write_exr(path, self.width, self.height, &pixels, self.color_space, Some((&wavelengths, &bins)));
+        }
         write_linear_srgb(path, self.width, self.height, &self.linear_srgb())
     }
 }
@@ -294,18 +431,33 @@ impl Film {
 /// Adds a tile's samples into `rows`, the film rows from `first_row` on
 /// (`width` pixels each). Non-finite samples are dropped, ones beyond
 /// ±[`MAX_SAMPLE`] clamped; both are counted in the return value.
-fn add_tile_to_rows(rows: &mut [[i128; 3]], width: u32, first_row: u32, tile: &Tile, samples: &[Xyz]) -> usize {
+fn add_tile_to_rows<S: FilmSample>(
+    rows: &mut [[i128; 3]],
+    mut spectral: Option<&mut [[i128; N_BINS]]>,
+    width: u32,
+    first_row: u32,
+    tile: &Tile,
+    samples: &[S],
+) -> usize {
     debug_assert_eq!(samples.len(), tile.len());
     let mut bad = 0;
     let mut k = 0;
     for y in tile.y0..tile.y1 {
         let row = (y - first_row) as usize * width as usize;
         for x in tile.x0..tile.x1 {
-            let s = samples[k];
+            let sample = samples[k];
+            let s = sample.xyz();
             k += 1;
-            if !(s.x.is_finite() && s.y.is_finite() && s.z.is_finite()) {
+            let bins = sample.bins();
+            if !(s.x.is_finite() && s.y.is_finite() && s.z.is_finite()) || bins.is_some_and(|b| b.has_nan_or_inf()) {
                 bad += 1;
                 continue;
+            }
+            if let (Some(spec), Some(b)) = (spectral.as_deref_mut(), bins) {
+                let sum = &mut spec[row + x as usize];
+                for (acc, &v) in sum.iter_mut().zip(&b.0) {
+                    *acc += to_fixed(v);
+                }
             }
             if s.x.abs().max(s.y.abs()).max(s.z.abs()) > MAX_SAMPLE {
                 bad += 1;

@@ -15,8 +15,10 @@
 //! - **Directions**: `wo` points back along the path, `wi` towards the next
 //!   vertex or the light; both away from the surface.
 //! - **pdfs** are per unit solid angle unless named `_area`.
-//! - **Spectra**: 36 bins, 380-730 nm every 10 nm ([`color`]); a pixel's XYZ is
-//!   `Σ_b L(b) · cmf(b)` normalised so the equal-energy spectrum of radiance 1 has `Y = 1`.
+//! - **Spectra**: 36 bins, 380-730 nm every 10 nm ([`color`]), meaning the linear
+//!   interpolation of the bins (flat beyond the ends); a pixel's XYZ is its exact colour
+//!   integral over 360-830 nm, `Σ_b L(b) · W_b` ([`color::color_weights`]), normalised so the
+//!   equal-energy spectrum of radiance 1 has `Y = 1`.
 //! - **Depth**: `max_bounces` counts scattering events ([`integrator`]).
 //! - **The outside medium** is vacuum, index 1 ([`bxdf`]).
 #![forbid(unsafe_code)]

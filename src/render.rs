@@ -29,11 +29,12 @@ use std::time::{Duration, Instant};
 use glam::Vec2;
 use rayon::prelude::*;
 
-use crate::color::Xyz;
-use crate::film::{Film, Tile, tiles};
+use crate::color::{Spectrum, Xyz};
+use crate::film::{Film, FilmSample, Tile, tiles};
 use crate::integrator::{Estimator, EstimatorFn, with_estimator};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
+use crate::spectral::Contribution;
 
 /// Tile edge in pixels.
 pub const TILE_SIZE: u32 = 16;
@@ -121,6 +122,17 @@ struct Run<'a, 'b> {
 
 impl EstimatorFn<RenderStats> for Run<'_, '_> {
     fn call<E: Estimator>(self, estimator: &E) -> RenderStats {
+        // A spectral film takes each sample's 36 bins; otherwise the samples are XYZ.
+        if self.film.spectral_sums().is_some() {
+            self.run::<E, Spectrum>(estimator)
+        } else {
+            self.run::<E, Xyz>(estimator)
+        }
+    }
+}
+
+impl Run<'_, '_> {
+    fn run<E: Estimator, O: Contribution + FilmSample>(self, estimator: &E) -> RenderStats {
         let Run { scene, film, passes, limits, on_pass } = self;
         if film.passes() == 0 {
             film.start_at(passes.start);
@@ -142,14 +154,14 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
                 break;
             }
             let k = batch.min(passes.end - next);
-            let results: Vec<Option<Vec<Xyz>>> = (0..k as usize * tiles.len())
+            let results: Vec<Option<Vec<O>>> = (0..k as usize * tiles.len())
                 .into_par_iter()
                 .map(|task| {
                     if limits.stop.load(Ordering::Relaxed) {
                         return None;
                     }
                     let pass = next + (task / tiles.len()) as u32;
-                    Some(render_tile(scene, estimator, film.width(), &tiles[task % tiles.len()], pass))
+                    Some(render_tile::<E, O>(scene, estimator, film.width(), &tiles[task % tiles.len()], pass))
                 })
                 .collect();
             // Keep the passes that finished whole, from the batch's first on.
@@ -159,7 +171,7 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
             } else {
                 results.chunks(tiles.len()).take_while(|p| p.iter().all(Option::is_some)).count()
             };
-            let samples: Vec<Vec<Xyz>> = results.into_iter().take(whole * tiles.len()).flatten().collect();
+            let samples: Vec<Vec<O>> = results.into_iter().take(whole * tiles.len()).flatten().collect();
             if whole > 0 {
                 if !tiles.is_empty() {
                     stats.invalid_samples += film.add_tiles_parallel(&tiles, &samples, TILE_SIZE) as u64;
@@ -189,7 +201,13 @@ impl EstimatorFn<RenderStats> for Run<'_, '_> {
 }
 
 /// One sample for every pixel of `tile` in pass `pass`.
-fn render_tile<E: Estimator>(scene: &Scene, estimator: &E, width: u32, tile: &Tile, pass: u32) -> Vec<Xyz> {
+fn render_tile<E: Estimator, O: Contribution>(
+    scene: &Scene,
+    estimator: &E,
+    width: u32,
+    tile: &Tile,
+    pass: u32,
+) -> Vec<O> {
     let seed = scene.settings.seed;
     let mut out = Vec::with_capacity(tile.len());
     for y in tile.y0..tile.y1 {

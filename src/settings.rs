@@ -23,6 +23,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::{Error, Result};
+
 /// Declares a closed set of named choices: the RON identifiers and
 /// command-line values are the lowercase names.
 macro_rules! named_enum {
@@ -55,6 +57,16 @@ macro_rules! named_enum {
                 }
             }
         }
+
+        impl Value for $name {
+            const CHOICES: &'static [&'static str] = $name::NAMES;
+            fn text(&self) -> String {
+                self.name().into()
+            }
+            fn parse(s: &str) -> std::result::Result<Self, String> {
+                Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
+            }
+        }
     };
 }
 
@@ -84,43 +96,19 @@ named_enum! {
     }
 }
 
-/// Encodes a named enum as its name (binary formats: the checkpoint header).
+/// Encodes a setting's value as its text (binary formats: the checkpoint
+/// header stores the enums as their names).
 mod by_name {
     use serde::{Deserialize, Deserializer, Serializer, de::Error as _};
 
-    pub trait Named: Sized + Copy {
-        fn name(self) -> &'static str;
-        fn from_name(s: &str) -> Option<Self>;
-        const WHAT: &'static str;
+    use super::Value;
+
+    pub fn serialize<T: Value, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&v.text())
     }
 
-    impl Named for super::IntegratorKind {
-        fn name(self) -> &'static str {
-            super::IntegratorKind::name(self)
-        }
-        fn from_name(s: &str) -> Option<Self> {
-            super::IntegratorKind::from_name(s)
-        }
-        const WHAT: &'static str = "integrator";
-    }
-
-    impl Named for super::WavelengthsKind {
-        fn name(self) -> &'static str {
-            super::WavelengthsKind::name(self)
-        }
-        fn from_name(s: &str) -> Option<Self> {
-            super::WavelengthsKind::from_name(s)
-        }
-        const WHAT: &'static str = "wavelength sampling";
-    }
-
-    pub fn serialize<T: Named, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(v.name())
-    }
-
-    pub fn deserialize<'de, T: Named, D: Deserializer<'de>>(d: D) -> Result<T, D::Error> {
-        let s = String::deserialize(d)?;
-        T::from_name(&s).ok_or_else(|| D::Error::custom(format!("unknown {} {s:?}", T::WHAT)))
+    pub fn deserialize<'de, T: Value, D: Deserializer<'de>>(d: D) -> Result<T, D::Error> {
+        T::parse(&String::deserialize(d)?).map_err(D::Error::custom)
     }
 }
 
@@ -176,25 +164,26 @@ macro_rules! settings {
                 vec![$((stringify!($field), self.$field.text()),)+]
             }
 
-            /// The first setting out of range, as `(field, what was expected)`.
-            pub fn check(&self) -> Result<(), (&'static str, String)> {
-                $($check(&self.$field).map_err(|m| (stringify!($field), m))?;)+
+            /// The first setting out of range ([`Error::Setting`]).
+            pub fn check(&self) -> Result<()> {
+                $($check(&self.$field).map_err(|message| Error::Setting { name: stringify!($field), message })?;)+
                 Ok(())
             }
         }
 
         impl SettingsPatch {
             /// Sets field `name` from its text (as in a scene file or on the
-            /// command line), checking the value's constraint.
-            pub fn set(&mut self, name: &str, text: &str) -> Result<(), String> {
+            /// command line), checking the value's constraint ([`Error::Setting`]).
+            pub fn set(&mut self, name: &str, text: &str) -> Result<()> {
                 match name {
                     $(stringify!($field) => {
-                        let v = <$ty as Value>::parse(text)?;
-                        $check(&v)?;
+                        let name = stringify!($field);
+                        let v = <$ty as Value>::parse(text).map_err(|message| Error::Setting { name, message })?;
+                        $check(&v).map_err(|message| Error::Setting { name, message })?;
                         self.$field = Some(v);
                         Ok(())
                     })+
-                    _ => Err(format!("unknown setting {name:?}")),
+                    _ => Err(Error::Settings(format!("unknown setting {name:?}"))),
                 }
             }
         }
@@ -237,20 +226,24 @@ pub struct Field {
     pub choices: &'static [&'static str],
 }
 
-fn any<T>(_: &T) -> Result<(), String> {
+/// A setting's constraint: `Err` holds what was expected (the caller adds
+/// the setting's name, making an [`Error::Setting`]).
+type Check = std::result::Result<(), String>;
+
+fn any<T>(_: &T) -> Check {
     Ok(())
 }
 
-fn positive(v: &u32) -> Result<(), String> {
+fn positive(v: &u32) -> Check {
     if *v == 0 { Err("expected a positive number, found 0".into()) } else { Ok(()) }
 }
 
-fn side(v: &u32) -> Result<(), String> {
+fn side(v: &u32) -> Check {
     positive(v)?;
     if *v > MAX_SIDE { Err(format!("expected at most {MAX_SIDE} pixels per side, found {v}")) } else { Ok(()) }
 }
 
-fn packet_size(v: &u32) -> Result<(), String> {
+fn packet_size(v: &u32) -> Check {
     if PACKET_SIZES.contains(v) { Ok(()) } else { Err(format!("expected 1, 2, 4 or 8, found {v}")) }
 }
 
@@ -259,48 +252,25 @@ trait Value: Sized {
     /// The closed set of names it takes (empty for numbers).
     const CHOICES: &'static [&'static str];
     fn text(&self) -> String;
-    fn parse(s: &str) -> Result<Self, String>;
+    fn parse(s: &str) -> std::result::Result<Self, String>;
 }
 
-impl Value for u32 {
-    const CHOICES: &'static [&'static str] = &[];
-    fn text(&self) -> String {
-        self.to_string()
-    }
-    fn parse(s: &str) -> Result<Self, String> {
-        s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", u32::MAX))
-    }
+/// Whole numbers as settings.
+macro_rules! number_value {
+    ($($ty:ty),+) => {$(
+        impl Value for $ty {
+            const CHOICES: &'static [&'static str] = &[];
+            fn text(&self) -> String {
+                self.to_string()
+            }
+            fn parse(s: &str) -> std::result::Result<Self, String> {
+                s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", <$ty>::MAX))
+            }
+        }
+    )+};
 }
 
-impl Value for u64 {
-    const CHOICES: &'static [&'static str] = &[];
-    fn text(&self) -> String {
-        self.to_string()
-    }
-    fn parse(s: &str) -> Result<Self, String> {
-        s.trim().parse().map_err(|_| format!("expected a whole number from 0 to {}, found {s:?}", u64::MAX))
-    }
-}
-
-impl Value for IntegratorKind {
-    const CHOICES: &'static [&'static str] = IntegratorKind::NAMES;
-    fn text(&self) -> String {
-        self.name().into()
-    }
-    fn parse(s: &str) -> Result<Self, String> {
-        Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
-    }
-}
-
-impl Value for WavelengthsKind {
-    const CHOICES: &'static [&'static str] = WavelengthsKind::NAMES;
-    fn text(&self) -> String {
-        self.name().into()
-    }
-    fn parse(s: &str) -> Result<Self, String> {
-        Self::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Self::NAMES.join(", ")))
-    }
-}
+number_value!(u32, u64);
 
 impl Settings {
     /// Defaults, then `file` (the scene's `render` block), then `cli`.
@@ -350,11 +320,11 @@ mod tests {
         p.set("max_bounces", "12").unwrap();
         p.set("integrator", "spectral").unwrap();
         assert_eq!((p.max_bounces, p.integrator), (Some(12), Some(IntegratorKind::Spectral)));
-        assert!(p.set("width", "0").unwrap_err().contains("positive"));
-        assert!(p.set("width", "40000").unwrap_err().contains("at most 32768"));
-        assert!(p.set("packet_size", "3").unwrap_err().contains("1, 2, 4 or 8"));
-        assert!(p.set("seed", "-1").unwrap_err().contains("whole number"));
-        assert!(p.set("integrator", "bdpt").unwrap_err().contains("auto, path, whitted, spectral"));
+        assert!(p.set("width", "0").unwrap_err().to_string().contains("width: expected a positive"));
+        assert!(p.set("width", "40000").unwrap_err().to_string().contains("at most 32768"));
+        assert!(p.set("packet_size", "3").unwrap_err().to_string().contains("1, 2, 4 or 8"));
+        assert!(p.set("seed", "-1").unwrap_err().to_string().contains("whole number"));
+        assert!(p.set("integrator", "bdpt").unwrap_err().to_string().contains("auto, path, whitted, spectral"));
         assert!(p.set("focus", "1").is_err());
         assert_eq!(
             FIELDS.iter().map(|f| f.name).collect::<Vec<_>>(),
@@ -367,9 +337,13 @@ mod tests {
     fn checks_and_differences() {
         let s = Settings::default();
         assert!(s.check().is_ok());
-        assert_eq!(Settings { width: 0, ..s.clone() }.check().unwrap_err().0, "width");
-        assert_eq!(Settings { height: MAX_SIDE + 1, ..s.clone() }.check().unwrap_err().0, "height");
-        assert_eq!(Settings { packet_size: 3, ..s.clone() }.check().unwrap_err().0, "packet_size");
+        let name = |s: Settings| match s.check() {
+            Err(Error::Setting { name, .. }) => name,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(name(Settings { width: 0, ..s.clone() }), "width");
+        assert_eq!(name(Settings { height: MAX_SIDE + 1, ..s.clone() }), "height");
+        assert_eq!(name(Settings { packet_size: 3, ..s.clone() }), "packet_size");
         let t = Settings { spp: 5, seed: 2, wavelengths: WavelengthsKind::Rgb, ..s.clone() };
         assert_eq!(s.differences(&t), vec!["seed 2 vs 0".to_string(), "wavelengths rgb vs hero".to_string()]);
     }

@@ -19,9 +19,9 @@
 //! between bins (only the RGB mode uses non-integer positions).
 //!
 //! # Unbiasedness
-//! The pixel value is `XYZ = Σ_b L(b) · cmf(b)` over the 36 bins (see
-//! [`crate::color::cie`]). A packet that includes bin `b` with probability
-//! `P(b)` contributes `L(b) · cmf(b) / P(b)` for each of its bins, so every
+//! The pixel value is `XYZ = Σ_b L(b) · W_b` over the 36 bins, the exact colour
+//! integral of the interpolated spectrum ([`color::color_weights`]). A packet that
+//! includes bin `b` with probability `P(b)` contributes `L(b) · W_b / P(b)` for each of its bins, so every
 //! bin's expected contribution is exactly its share of the sum, at any sample
 //! count. Hero and random packets of `C` bins have `P(b) = C / 36` (hero: the
 //! rotation puts each bin in the packet for exactly `C` of the 36 hero
@@ -47,7 +47,7 @@ pub const REFERENCE_LAMBDA_NM: f32 = 589.3;
 /// How a packet's values become a colour.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Readout {
-    /// Values are spectral radiance at the packet's bins: XYZ through the CMFs.
+    /// Values are spectral radiance at the packet's bins: XYZ through the colour weights.
     Spectral,
     /// Values are linear sRGB (blue, green, red), the RGB mode.
     Rgb,
@@ -105,7 +105,7 @@ impl<const N: usize> Lambdas<N> {
                 // The identity packet (the full spectrum): bin i is value i, no
                 // index conversion (this runs once per camera sample).
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
-                for (v, w) in l.0.iter().zip(&color::CMF_NORMALISED) {
+                for (v, w) in l.0.iter().zip(color::color_weights()) {
                     x += v * w[0];
                     y += v * w[1];
                     z += v * w[2];
@@ -116,7 +116,7 @@ impl<const N: usize> Lambdas<N> {
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
                 for i in 0..N {
                     // Packets of sampled bins always sit on integer positions.
-                    let w = color::CMF_NORMALISED[self.pos[i] as usize];
+                    let w = color::color_weights()[self.pos[i] as usize];
                     x += l.0[i] * w[0];
                     y += l.0[i] * w[1];
                     z += l.0[i] * w[2];
@@ -134,6 +134,46 @@ impl<const N: usize> Lambdas<N> {
                 color::LinearSrgb::new(rgb[0], rgb[1], rgb[2]).to_xyz()
             }
         }
+    }
+}
+
+impl<const N: usize> Lambdas<N> {
+    /// The per-bin radiance estimate of a packet of radiance values: each wavelength's value
+    /// times the packet weight, in its bin (bins outside the packet are 0), so that
+    /// `bins(l).to_xyz() == xyz(l)` up to rounding. The spectral film sums these. The RGB mode
+    /// has no bins: it gives zero (the command line refuses `--spectral` with it).
+    pub fn bins(&self, l: &Sampled<N>) -> Spectrum {
+        let mut out = Spectrum::ZERO;
+        if self.readout == Readout::Spectral {
+            for i in 0..N {
+                // Packets of sampled bins always sit on integer positions.
+                out.0[(self.pos[i] as usize).min(N_BINS - 1)] += l.0[i] * self.weight;
+            }
+        }
+        out
+    }
+}
+
+/// What an integrator returns for one camera sample: its colour ([`Xyz`]) or, for spectral
+/// output, its per-bin radiance estimate ([`Spectrum`], whose colour integral is that colour).
+/// The integrators are generic over it, so the colour-only path pays nothing for spectral
+/// output.
+pub(crate) trait Contribution: Copy + Default + core::ops::AddAssign + Send + Sync + 'static {
+    /// The contribution of a packet's radiance values.
+    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self;
+}
+
+impl Contribution for Xyz {
+    #[inline]
+    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
+        lambdas.xyz(l)
+    }
+}
+
+impl Contribution for Spectrum {
+    #[inline]
+    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
+        lambdas.bins(l)
     }
 }
 
@@ -196,7 +236,7 @@ pub fn sample_packet<const C: usize>(how: WavelengthSampling, u: [f32; C]) -> La
 
 /// The visual importance of each bin: the Euclidean norm of the linear sRGB
 /// colour that one unit of radiance in the bin adds to a pixel
-/// (`|M · cmf(b)|`, with [`color::XYZ_TO_LINEAR_SRGB`] as `M`). A sample's
+/// (`|M · W_b|`, the exact colour weights, with [`color::XYZ_TO_LINEAR_SRGB`] as `M`). A sample's
 /// squared error summed over the three channels scales with it, so `auto`
 /// draws its packets in proportion to it (times the path's throughput) where
 /// a path meets dispersion.

@@ -402,3 +402,38 @@ fn help_documents_the_checkpoint_flags_and_subcommands() {
     }
     assert!(help(&["merge", "--help"]).contains("--output"));
 }
+
+/// The same promise for a spectral film (`--spectral`) on a dispersive scene (the prism: `auto`
+/// splits into single wavelengths there): 0..40 == merge(0..20, 20..40) == 0..20 saved (format
+/// version 2), loaded and continued, bit for bit in the XYZ and the 36 per-bin sums; and a
+/// colour-only checkpoint still writes version 1.
+#[test]
+fn spectral_films_merge_and_resume_bit_identically() {
+    let mut o = SettingsPatch::default();
+    (o.width, o.height) = (Some(12), Some(12));
+    let scene = load_scene(&root().join("scenes/prism.ron"), &o).expect("prism loads");
+    let mut whole = Film::new_spectral(12, 12, 0);
+    render_into(&scene, &mut whole, 0..40);
+    let mut a = Film::new_spectral(12, 12, 0);
+    render_into(&scene, &mut a, 0..20);
+    let mut b = Film::new_spectral(12, 12, 20);
+    render_into(&scene, &mut b, 20..40);
+    let parts = vec![(PathBuf::from("b"), meta(&scene, b)), (PathBuf::from("a"), meta(&scene, a.clone()))];
+    let merged = merge(parts).expect("disjoint ranges merge");
+    assert_eq!(merged.film, whole);
+    assert!(whole.spectral_sums().unwrap().iter().any(|p| p.iter().any(|&v| v != 0)));
+
+    let bytes = meta(&scene, a.clone()).encode().unwrap();
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), rust_v::checkpoint::SPECTRAL_FORMAT_VERSION);
+    let mut resumed = Checkpoint::decode(&bytes, Path::new("a.ckpt")).unwrap().film;
+    assert_eq!(resumed, a);
+    render_into(&scene, &mut resumed, 20..40);
+    assert_eq!(resumed, whole);
+
+    // A spectral and a colour-only film do not merge; colour-only checkpoints stay version 1.
+    let mut plain = Film::starting_at(12, 12, 20);
+    render_into(&scene, &mut plain, 20..40);
+    assert!(a.clone().merge(&plain).is_err());
+    let bytes = meta(&scene, plain).encode().unwrap();
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), rust_v::checkpoint::FORMAT_VERSION);
+}

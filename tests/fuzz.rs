@@ -437,3 +437,152 @@ fn the_fuzz_path_helpers_name_files() {
     let e = Mesh::load(p, &Transform::default()).expect_err("missing file");
     assert!(e.to_string().contains("x.ply"));
 }
+
+/// Command-line invocations in [`fuzz_command_line`] when
+/// `RUST_V_CLI_FUZZ_CASES` is not set (each starts a process: ~0.1 s).
+const CLI_CASES: u64 = 48;
+
+/// Values a flag is given: the edges of every numeric type, signs, NaN,
+/// infinities, empty and malformed text, paths that are not files.
+const FLAG_VALUES: &[&str] = &[
+    "0",
+    "1",
+    "2",
+    "3",
+    "8",
+    "16",
+    "-1",
+    "40000",
+    "4294967295",
+    "4294967296",
+    "18446744073709551616",
+    "1e300",
+    "-1e300",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "0.5",
+    "1e-300",
+    "",
+    " ",
+    "x",
+    "0..2",
+    "2..1",
+    "3..3",
+    "a..b",
+    "0..4294967296",
+    "auto",
+    "path",
+    "whitted",
+    "spectral",
+    "hero",
+    "random",
+    "rgb",
+    "/dev/null",
+    "/proc",
+    "/nonexistent/out.png",
+    ".",
+    "out.png",
+    "out.exr",
+    "out.ckpt",
+    "é.png",
+];
+
+/// Flags with values, per subcommand; `--time 0.3` bounds every render.
+const RENDER_FLAGS: &[&str] = &[
+    "--spp",
+    "--seed",
+    "--width",
+    "--height",
+    "--max-bounces",
+    "--integrator",
+    "--wavelengths",
+    "--packet-size",
+    "--threads",
+    "--passes",
+    "--checkpoint",
+    "--checkpoint-every",
+    "--time",
+    "-o",
+];
+const RESUME_FLAGS: &[&str] = &["--spp", "--threads", "--checkpoint", "--checkpoint-every", "-o"];
+const SWITCHES: &[&str] = &["-q", "--quiet", "--force", "--json", "--bogus", "-"];
+
+/// Random subcommands, flags and values through the binary: every run ends
+/// with status 0, 1 (an error) or 2 (a usage error), never a panic, and
+/// every failure is exactly one `rust-v: error:` line. A failing case prints
+/// its command line.
+#[test]
+fn fuzz_command_line() {
+    let n = std::env::var("RUST_V_CLI_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(CLI_CASES);
+    let dir = temp_dir("fuzz-cli");
+    let scene = dir.join("s.ron");
+    std::fs::write(
+        &scene,
+        r#"(camera: (eye: (0, 0, 4), look_at: (0, 0, 0), fov_deg: 30), render: (width: 4, height: 4, spp: 1),
+            materials: { "w": Lambertian(reflectance: Constant(0.5)) },
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "w") ],
+            lights: [ Point(position: (0, 3, 3), intensity: Constant(10)) ])"#,
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_rust-v");
+    let ok = std::process::Command::new(bin)
+        .current_dir(&dir)
+        .args(["render", "s.ron", "-q", "-o", "ref.png", "--checkpoint", "ref.ckpt"])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let mut rng = Pcg32::new(0x05ee_dc11, 0xda3e_39cb_94b9_5bdb);
+    let (mut codes, mut panics) = ([0u32; 3], Vec::new());
+    for case in 0..n {
+        let pick = |rng: &mut Pcg32, v: &[&'static str]| v[below(rng, v.len())];
+        let sub = pick(&mut rng, &["render", "render", "render", "resume", "merge", "compare"]);
+        let mut args: Vec<String> = vec![sub.into()];
+        let flags = match sub {
+            "render" => {
+                args.push("s.ron".into());
+                RENDER_FLAGS
+            }
+            "resume" => {
+                args.push("ref.ckpt".into());
+                RESUME_FLAGS
+            }
+            "merge" => {
+                args.extend(["ref.ckpt".into(), "-o".into()]);
+                &["--quiet"][..]
+            }
+            _ => {
+                args.extend(["ref.png".into(), "ref.png".into()]);
+                &["--json"][..]
+            }
+        };
+        for _ in 0..below(&mut rng, 5) {
+            if below(&mut rng, 4) == 0 {
+                args.push(pick(&mut rng, SWITCHES).into());
+            } else {
+                args.push(pick(&mut rng, flags).into());
+                args.push(pick(&mut rng, FLAG_VALUES).into());
+            }
+        }
+        if sub == "render" || sub == "resume" {
+            args.extend(["--time".into(), "0.3".into()]);
+        }
+        let what = format!("case {case}: rust-v {}", args.join(" "));
+        let o = std::process::Command::new(bin).current_dir(&dir).args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        if err.contains("panicked") || err.contains("backtrace") {
+            panics.push(format!("{what}\n{err}"));
+            continue;
+        }
+        let code = o.status.code().unwrap_or_else(|| panic!("{what}: killed by a signal\n{err}"));
+        assert!(code <= 2, "{what}: exit {code}\n{err}");
+        codes[code as usize] += 1;
+        if code != 0 {
+            let lines = err.lines().filter(|l| l.starts_with("rust-v: error:")).count();
+            assert_eq!(lines, 1, "{what}: expected one error line\n{err}");
+        }
+    }
+    assert!(panics.is_empty(), "panics:\n{}", panics.join("\n"));
+    eprintln!("fuzz_command_line: {n} runs: {} ok, {} errors, {} usage errors", codes[0], codes[1], codes[2]);
+}

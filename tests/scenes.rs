@@ -87,7 +87,11 @@ fn readme_scene_example_loads() {
     // Paths in the example are relative to a scene in scenes/.
     let scene = rust_v::scene::load_scene_str(example, &root().join("scenes/readme-example.ron"), &Default::default())
         .unwrap_or_else(|e| panic!("README example: {e}"));
-    assert_eq!(scene.object_count(), 8);
-    assert_eq!(scene.lights.len(), 3, "disk, sphere and point lights");
+    assert_eq!(scene.object_count(), 11);
+    assert_eq!(
+        scene.lights.len(),
+        9,
+        "disk, sphere, quad, cuboid and mesh emitters; point, spot, distant and beam lights"
+    );
     assert!(scene.has_dispersion());
 }

@@ -8,6 +8,8 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{ArgMatches, Args, FromArgMatches, Parser, Subcommand};
 
+use rust_v::color::ColorSpace;
+use rust_v::error::Error;
 use rust_v::settings::{FIELDS, SettingsPatch};
 
 /// rust-v: a physically based spectral path tracer.
@@ -76,10 +78,17 @@ pub struct ConvergeArgs {
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub settings: SettingsArgs,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// How a command that renders runs: threads and what it prints.
+#[derive(Debug, Args, Clone, Default)]
+pub struct RunArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
-    /// No progress lines on stderr.
+    /// No progress bar, progress lines or summary on stderr (warnings still print).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -92,14 +101,19 @@ pub struct RenderArgs {
     /// Output image: `.png` (16-bit sRGB) or `.exr` (linear sRGB, float). Default: the scene's name with `.png`, in the current directory.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Colour space of EXR output: srgb (linear, default), rec2020, acescg (Bradford-adapted
+    /// from D65) or xyz. PNG output is always sRGB.
+    #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
+    pub color_space: ColorSpace,
+    /// With an .exr output: also write the 36 spectral bins (380-730 nm) as channels in the
+    /// layout of Fichet et al. 2021, summed exactly like the colour (the checkpoint then holds
+    /// them too, so resumed and merged renders stay bit-identical).
+    #[arg(long)]
+    pub spectral: bool,
     #[command(flatten)]
     pub settings: SettingsArgs,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-    /// No progress bar or summary on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
+    #[command(flatten)]
+    pub run: RunArgs,
     /// Render only passes A to B-1 (`A..B`), e.g. one job's share of a distributed render.
     #[arg(long, value_name = "A..B", value_parser = parse_pass_range)]
     pub passes: Option<Range<u32>>,
@@ -114,8 +128,9 @@ pub struct RenderArgs {
 /// Checkpoint flags shared by `render` and `resume`.
 #[derive(Debug, Args, Clone, Default)]
 pub struct CheckpointArgs {
-    /// Checkpoint file (default: the output's name with `.ckpt`). When given, the
-    /// checkpoint is also written when the render finishes.
+    /// Checkpoint file (default: for `render` the output's name with `.ckpt`, for
+    /// `resume` the checkpoint resumed). When given, the checkpoint is also written
+    /// when the render finishes.
     #[arg(long, value_name = "PATH")]
     pub checkpoint: Option<PathBuf>,
     /// Write a checkpoint every SECONDS (between batches of passes).
@@ -134,19 +149,14 @@ pub struct ResumeArgs {
     /// Output image, `.png` or `.exr` (default: the original render's output).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-    /// No progress bar or summary on stderr.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// Checkpoint file (default: the checkpoint resumed). When given, the
-    /// checkpoint is also written when the render finishes.
-    #[arg(long, value_name = "PATH")]
-    pub checkpoint: Option<PathBuf>,
-    /// Write a checkpoint every SECONDS (between batches of passes).
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
-    pub checkpoint_every: Option<f64>,
+    /// Colour space of EXR output: srgb (linear, default; not stored in the checkpoint: give it again), rec2020, acescg (Bradford-adapted
+    /// from D65) or xyz. PNG output is always sRGB.
+    #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
+    pub color_space: ColorSpace,
+    #[command(flatten)]
+    pub run: RunArgs,
+    #[command(flatten)]
+    pub checkpoint: CheckpointArgs,
     /// Resume even if the scene file changed since the checkpoint was written (the
     /// image then mixes passes of two scenes; the new checkpoint records the new scene).
     #[arg(long)]
@@ -162,27 +172,42 @@ pub struct MergeArgs {
     /// Output: `.png` or `.exr` writes the image, `.ckpt` a merged checkpoint.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Colour space of EXR output: srgb (linear, default), rec2020, acescg (Bradford-adapted
+    /// from D65) or xyz. PNG output is always sRGB.
+    #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
+    pub color_space: ColorSpace,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
 }
 
+/// A colour space by name.
+fn parse_color_space(s: &str) -> std::result::Result<ColorSpace, String> {
+    ColorSpace::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", ColorSpace::NAMES.join(", ")))
+}
+
 /// `A..B` with A < B.
-fn parse_pass_range(s: &str) -> std::result::Result<Range<u32>, String> {
-    let (a, b) = s.split_once("..").ok_or_else(|| format!("expected A..B (e.g. 0..64), got {s:?}"))?;
-    let a: u32 = a.trim().parse().map_err(|e| format!("start {a:?}: {e}"))?;
-    let b: u32 = b.trim().parse().map_err(|e| format!("end {b:?}: {e}"))?;
+fn parse_pass_range(s: &str) -> Result<Range<u32>, Error> {
+    let bad = Error::Settings;
+    let (a, b) = s.split_once("..").ok_or_else(|| bad(format!("expected A..B (e.g. 0..64), got {s:?}")))?;
+    let a: u32 = a.trim().parse().map_err(|e| bad(format!("start {a:?}: {e}")))?;
+    let b: u32 = b.trim().parse().map_err(|e| bad(format!("end {b:?}: {e}")))?;
     if a >= b {
-        return Err(format!("{a}..{b} is empty: the end must be greater than the start"));
+        return Err(bad(format!("{a}..{b} is empty: the end must be greater than the start")));
     }
     Ok(a..b)
 }
 
-/// A positive, finite number of seconds.
-fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("expected a positive number of seconds, got {s:?}")),
+/// The longest time a flag takes: a year, in seconds.
+pub const MAX_SECONDS: f64 = 365.25 * 24.0 * 3600.0;
+
+/// A positive, finite number of seconds, at most [`MAX_SECONDS`].
+fn parse_seconds(s: &str) -> Result<f64, Error> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= MAX_SECONDS => Ok(v),
+        _ => Err(Error::Settings(format!(
+            "expected a positive number of seconds up to {MAX_SECONDS} (a year), got {s:?}"
+        ))),
     }
 }
 
@@ -217,7 +242,13 @@ impl Args for SettingsArgs {
             let name = f.name;
             let arg = clap::Arg::new(name).long(flag(name)).value_name(name.to_uppercase()).help(f.doc.trim());
             cmd = cmd.arg(if f.choices.is_empty() {
-                arg.value_parser(move |s: &str| SettingsPatch::default().set(name, s).map(|()| s.to_string()))
+                arg.value_parser(move |s: &str| {
+                    SettingsPatch::default().set(name, s).map(|()| s.to_string()).map_err(|e| match e {
+                        // clap names the flag; the message says what was expected.
+                        Error::Setting { message, .. } => Error::Settings(message),
+                        e => e,
+                    })
+                })
             } else {
                 arg.value_parser(PossibleValuesParser::new(f.choices))
             });

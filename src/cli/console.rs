@@ -1,14 +1,28 @@
-//! The console: what a user sees on stderr while rust-v works (a progress
-//! bar, notes and warnings, a render's summary), and the worker thread pool
-//! the commands share.
+//! The console: what a user sees while rust-v works (a progress bar, notes
+//! and warnings, a render's summary), and the worker thread pool the
+//! commands share.
+//!
+//! Nothing here can abort a render: every write to stderr or stdout ignores
+//! (stderr) or returns (stdout) its error, so a closed pipe, a full disk
+//! behind a redirection or `2>&1 | head` never panics and never loses an
+//! image. The progress bar (indicatif) is drawn only when stderr is a
+//! terminal; otherwise a plain progress line goes out at most every
+//! [`PLAIN_EVERY`].
+//!
+//! `--quiet` silences progress, notes and summaries; warnings always print.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::Path;
 use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use rust_v::error::{Error, Result};
 use rust_v::render::{Progress, RenderStats};
 use rust_v::scene::Scene;
+
+/// Without a terminal, a plain progress line at most this often.
+pub const PLAIN_EVERY: Duration = Duration::from_secs(30);
 
 /// A pool of `threads` workers (default: one per core).
 pub fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
@@ -16,80 +30,139 @@ pub fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
     if let Some(n) = threads {
         b = b.num_threads(n as usize);
     }
-    b.build().map_err(|e| Error::Settings(format!("cannot start {threads:?} threads: {e}")))
+    b.build().map_err(|e| {
+        let n = threads.map_or_else(|| "the default number of".to_string(), |n| n.to_string());
+        Error::Settings(format!("cannot start {n} threads: {e}"))
+    })
+}
+
+/// Writes `rust-v: LINE` to stderr; a failed write is ignored (there is
+/// nowhere left to report it).
+pub fn say(line: std::fmt::Arguments<'_>) {
+    let _ = writeln!(std::io::stderr().lock(), "rust-v: {line}");
+}
+
+/// Writes `rust-v: warning: LINE` to stderr (even with `--quiet`).
+pub fn warn(line: std::fmt::Arguments<'_>) {
+    let _ = writeln!(std::io::stderr().lock(), "rust-v: warning: {line}");
+}
+
+/// Writes `text` to stdout (the command's data, e.g. `compare --json`);
+/// unlike stderr, a failure here is the command's failure.
+pub fn out(text: &str) -> Result<()> {
+    let mut o = std::io::stdout().lock();
+    o.write_all(text.as_bytes())
+        .and_then(|()| o.flush())
+        .map_err(|e| Error::Settings(format!("cannot write to standard output: {e}")))
 }
 
 /// Prints the warnings and the summary of a finished render.
 pub fn report(scene: &Scene, stats: &RenderStats, output: &Path, quiet: bool) {
     if stats.invalid_samples > 0 {
-        eprintln!(
-            "rust-v: warning: {} samples were NaN, infinite (dropped) or beyond ±2^31 (clamped): a bug, please report it",
+        warn(format_args!(
+            "{} samples were NaN, infinite (dropped) or beyond ±2^31 (clamped): a bug, please report it",
             stats.invalid_samples
-        );
+        ));
     }
     if !quiet {
         let samples = stats.passes as f64 * scene.settings.width as f64 * scene.settings.height as f64;
-        eprintln!(
-            "rust-v: wrote {} ({} passes in {:.2} s, {:.3} Msamples/s)",
+        say(format_args!(
+            "wrote {} ({} passes in {:.2} s, {:.3} Msamples/s)",
             output.display(),
             stats.passes,
             stats.elapsed.as_secs_f64(),
             samples / stats.elapsed.as_secs_f64().max(1e-9) / 1e6
-        );
+        ));
     }
 }
 
-/// A one-line progress bar on stderr: passes done, samples per second, time left.
-pub struct ProgressBar {
+/// Render progress: an indicatif bar on a terminal, an occasional plain
+/// line otherwise, nothing with `--quiet`.
+pub struct ProgressView {
     quiet: bool,
-    last: Option<Instant>,
+    bar: Option<ProgressBar>,
+    last_plain: Option<Instant>,
     budget: Option<Duration>,
 }
 
-impl ProgressBar {
-    /// A bar that prints nothing when `quiet`; with a time budget, time left counts down to it.
+impl ProgressView {
+    /// A view that prints nothing when `quiet`; with a time budget, time left counts down to it.
     pub fn new(quiet: bool, budget: Option<Duration>) -> Self {
-        ProgressBar { quiet, last: None, budget }
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr_with_hz(5));
+            let style = if budget.is_some() {
+                ProgressStyle::with_template("{spinner} pass {pos} {msg}")
+            } else {
+                ProgressStyle::with_template("[{bar:30}] pass {pos}/{len} {msg}")
+            };
+            bar.set_style(style.unwrap_or_else(|_| ProgressStyle::default_bar()).progress_chars("=> "));
+            bar
+        });
+        ProgressView { quiet, bar, last_plain: None, budget }
     }
 
-    /// Redraws the bar (at most every 200 ms, and after the last pass).
+    /// Shows the progress after a batch of passes.
     pub fn update(&mut self, p: &Progress) {
-        let done = p.passes_this_run == p.passes_planned;
-        if self.quiet || (!done && self.last.is_some_and(|t| t.elapsed() < Duration::from_millis(200))) {
+        if self.quiet {
             return;
         }
-        self.last = Some(Instant::now());
         let secs = p.elapsed.as_secs_f64().max(1e-9);
         let rate = p.passes_this_run as f64 * p.samples_per_pass as f64 / secs;
-        let mut left = secs / p.passes_this_run as f64 * (p.passes_planned - p.passes_this_run) as f64;
-        let width = 30;
-        let mut filled = (width as u64 * p.passes_this_run as u64 / p.passes_planned.max(1) as u64) as usize;
+        let mut left =
+            secs / p.passes_this_run.max(1) as f64 * p.passes_planned.saturating_sub(p.passes_this_run) as f64;
         if let Some(b) = self.budget {
-            let b = b.as_secs_f64();
-            if b - secs < left {
-                left = (b - secs).max(0.0);
-                filled = ((width as f64 * secs / b) as usize).min(width);
+            left = left.min((b.as_secs_f64() - secs).max(0.0));
+        }
+        let open_ended = p.passes_planned == u32::MAX;
+        let msg = format!("{:.2} Msamples/s  {:.1} s left", rate / 1e6, left);
+        match &self.bar {
+            Some(bar) => {
+                if !open_ended {
+                    bar.set_length(p.passes_planned as u64);
+                }
+                bar.set_position(p.passes_this_run as u64);
+                bar.set_message(msg);
+            }
+            None => {
+                let done = p.passes_this_run == p.passes_planned;
+                if done || self.last_plain.is_some_and(|t| t.elapsed() < PLAIN_EVERY) {
+                    return;
+                }
+                if self.last_plain.is_none() {
+                    // The first batch: start the clock, print nothing yet.
+                    self.last_plain = Some(Instant::now());
+                    return;
+                }
+                self.last_plain = Some(Instant::now());
+                let of = if open_ended { String::new() } else { format!("/{}", p.passes_planned) };
+                say(format_args!("pass {}{of}, {msg}", p.passes_this_run));
             }
         }
-        let mut err = std::io::stderr().lock();
-        let _ = write!(
-            err,
-            "\r[{}{}] pass {}{}  {:.2} Msamples/s  {:.1} s left   ",
-            "=".repeat(filled),
-            " ".repeat(width - filled),
-            p.passes_this_run,
-            if p.passes_planned == u32::MAX { String::new() } else { format!("/{}", p.passes_planned) },
-            rate / 1e6,
-            left
-        );
-        let _ = err.flush();
     }
 
-    /// Ends the bar's line.
-    pub fn finish(&mut self) {
-        if !self.quiet && self.last.is_some() {
-            eprintln!();
+    /// Prints a note (not with `--quiet`) without tearing the bar.
+    pub fn note(&self, line: std::fmt::Arguments<'_>) {
+        if !self.quiet {
+            self.above(|| say(line));
         }
-        self.last = None;
+    }
+
+    /// Prints a warning (always) without tearing the bar.
+    pub fn warn(&self, line: std::fmt::Arguments<'_>) {
+        self.above(|| warn(line));
+    }
+
+    fn above(&self, f: impl FnOnce()) {
+        match &self.bar {
+            Some(bar) => bar.suspend(f),
+            None => f(),
+        }
+    }
+
+    /// Removes the bar.
+    pub fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
     }
 }

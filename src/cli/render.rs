@@ -1,16 +1,24 @@
 //! `render`, `resume` and `merge`: from a scene file (or checkpoints) to an
 //! image. A render's passes run in a [`Session`] (signals, snapshots,
 //! checkpoints); `merge` sums checkpoints of disjoint pass ranges.
+//!
+//! Before any pass is rendered, every file the command will write is
+//! checked ([`check_files`]): each can be created, none is an input (the
+//! scene, a mesh or data file, a checkpoint read) or another output, and the
+//! film fits in the machine's memory.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
+use rust_v::color::ColorSpace;
 use rust_v::error::{Error, Result};
-use rust_v::film::Film;
-use rust_v::scene::load_scene;
+use rust_v::film::{Film, MAX_SAMPLE};
+use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, parent_dir};
+use rust_v::scene::{Scene, load_scene};
 
 use super::args::{MergeArgs, RenderArgs, ResumeArgs};
+use super::console::{say, warn};
 use super::session::{Session, SessionPlan};
 
 fn default_output(scene: &Path) -> PathBuf {
@@ -24,13 +32,23 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let session = Session::start()?;
     let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
     check_output_extension(&output)?;
+    check_color_space(&output, args.color_space)?;
+    if args.spectral && !rust_v::io::image::is_exr(&output) {
+        return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", output.display())));
+    }
     let load_start = Instant::now();
     let scene = load_scene(&args.scene, &args.settings.overrides())?;
     let load_time = load_start.elapsed();
     let s = &scene.settings;
-    if !args.quiet {
-        eprintln!(
-            "rust-v: {} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}\nrust-v: {}",
+    if args.spectral
+        && s.integrator == rust_v::settings::IntegratorKind::Spectral
+        && s.wavelengths == rust_v::settings::WavelengthsKind::Rgb
+    {
+        return Err(Error::Settings("--spectral: the RGB mode (--wavelengths rgb) has no spectral bins".into()));
+    }
+    if !args.run.quiet {
+        say(format_args!(
+            "{} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}",
             args.scene.display(),
             scene.object_count(),
             scene.lights.len(),
@@ -40,29 +58,36 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
             s.spp,
             s.max_bounces,
             s.seed,
-            rust_v::integrator::describe(&scene)
-        );
+        ));
+        say(format_args!("{}", rust_v::integrator::describe(&scene)));
     }
     // With a time budget and no --spp (or --passes), render until the time is up.
     let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
+    let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output));
+    check_files(&args.scene, &scene, &[], &output, &checkpoint_path, args.spectral)?;
     let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
-    let checkpoint = Checkpoint {
+    let mut checkpoint = Checkpoint {
         crate_version: env!("CARGO_PKG_VERSION").into(),
         scene_path,
         content_hash: scene.content_hash,
         settings: scene.settings.clone(),
         target_end: passes.end,
         output: std::path::absolute(&output).map_err(|e| Error::io(&output, e))?,
-        film: Film::starting_at(s.width, s.height, passes.start),
+        film: if args.spectral {
+            Film::new_spectral(s.width, s.height, passes.start)
+        } else {
+            Film::starting_at(s.width, s.height, passes.start)
+        },
     };
+    checkpoint.film.set_color_space(args.color_space);
     let plan = SessionPlan {
-        checkpoint_path: args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output)),
+        checkpoint_path,
         final_checkpoint: args.checkpoint.checkpoint.is_some(),
         every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
         output,
-        threads: args.threads,
-        quiet: args.quiet,
+        threads: args.run.threads,
+        quiet: args.run.quiet,
         budget: args.time.map(Duration::from_secs_f64),
     };
     session.run(&scene, checkpoint, passes.end, &plan)
@@ -72,13 +97,13 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     let session = Session::start()?;
     let mut ckpt = Checkpoint::read(&args.checkpoint_file)?;
     let path = &args.checkpoint_file;
-    if ckpt.crate_version != env!("CARGO_PKG_VERSION") && !args.quiet {
-        eprintln!(
-            "rust-v: warning: {} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
+    if ckpt.crate_version != env!("CARGO_PKG_VERSION") {
+        warn(format_args!(
+            "{} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
             path.display(),
             ckpt.crate_version,
             env!("CARGO_PKG_VERSION")
-        );
+        ));
     }
     let done = ckpt.passes();
     let end = match args.spp {
@@ -90,20 +115,22 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     }
     let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
     check_output_extension(&output)?;
+    check_color_space(&output, args.color_space)?;
+    ckpt.film.set_color_space(args.color_space);
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
     if scene.content_hash != ckpt.content_hash && args.force {
-        eprintln!(
-            "rust-v: warning: {} changed since the checkpoint was written; resuming anyway (--force)",
+        warn(format_args!(
+            "{} or a file it reads changed since the checkpoint was written; resuming anyway (--force)",
             ckpt.scene_path.display()
-        );
+        ));
         ckpt.content_hash = scene.content_hash;
     }
     if scene.content_hash != ckpt.content_hash {
         return Err(Error::checkpoint(
             path,
             format!(
-                "the scene file {} changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same scene (or --force)",
+                "the scene {} or a file it reads (mesh, data) changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
                 ckpt.scene_path.display(),
                 scene.content_hash,
                 ckpt.content_hash
@@ -111,27 +138,33 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
         ));
     }
     if scene.settings != ckpt.settings {
-        return Err(Error::checkpoint(path, format!("its settings {:?} load as {:?}", ckpt.settings, scene.settings)));
+        let diffs = scene.settings.differences(&ckpt.settings).join(", ");
+        return Err(Error::checkpoint(path, format!("its settings load differently: {diffs}")));
     }
-    if !args.quiet {
-        eprintln!(
-            "rust-v: resuming {} ({}): passes {}..{} done, rendering to pass {}",
+    if !args.run.quiet {
+        say(format_args!(
+            "resuming {} ({}): passes {}..{} done, rendering to pass {}",
             path.display(),
             ckpt.scene_path.display(),
             done.start,
             done.end,
             end.max(done.end)
-        );
+        ));
     }
     ckpt.target_end = end.max(done.end);
     ckpt.output = std::path::absolute(&output).map_err(|e| Error::io(&output, e))?;
+    let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| path.clone());
+    // The checkpoint resumed is an input unless it is also where new checkpoints go.
+    let resumed = [("checkpoint resumed", path.as_path())];
+    let extra: &[(&str, &Path)] = if args.checkpoint.checkpoint.is_some() { &resumed } else { &[] };
+    check_files(&ckpt.scene_path, &scene, extra, &output, &checkpoint_path, ckpt.film.spectral_sums().is_some())?;
     let plan = SessionPlan {
-        checkpoint_path: args.checkpoint.clone().unwrap_or_else(|| path.clone()),
-        final_checkpoint: args.checkpoint.is_some(),
-        every: args.checkpoint_every.map(Duration::from_secs_f64),
+        checkpoint_path,
+        final_checkpoint: args.checkpoint.checkpoint.is_some(),
+        every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
         output,
-        threads: args.threads,
-        quiet: args.quiet,
+        threads: args.run.threads,
+        quiet: args.run.quiet,
         budget: None,
     };
     session.run(&scene, ckpt, end, &plan)
@@ -143,11 +176,18 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
         check_output_extension(&args.output)
             .map_err(|_| Error::Settings(format!("output {}: expected .png, .exr or .ckpt", args.output.display())))?;
     }
+    check_output(&args.output, "output")?;
+    let inputs: Vec<(&str, &Path)> = args.parts.iter().map(|p| ("checkpoint", p.as_path())).collect();
+    check_aliasing(&inputs, &[("output", &args.output)])?;
     let mut parts = Vec::with_capacity(args.parts.len());
     for p in &args.parts {
         parts.push((p.clone(), Checkpoint::read(p)?));
     }
-    let merged = merge(parts)?;
+    let mut merged = merge(parts)?;
+    if !is_ckpt {
+        check_color_space(&args.output, args.color_space)?;
+        merged.film.set_color_space(args.color_space);
+    }
     if is_ckpt {
         merged.write(&args.output)?;
     } else {
@@ -155,13 +195,25 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     }
     if !args.quiet {
         let r = merged.passes();
-        eprintln!(
-            "rust-v: merged {} checkpoints (passes {}..{}) into {}",
+        say(format_args!(
+            "merged {} checkpoints (passes {}..{}) into {}",
             args.parts.len(),
             r.start,
             r.end,
             args.output.display()
-        );
+        ));
+    }
+    Ok(())
+}
+
+/// A colour space other than sRGB needs an EXR output.
+fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
+    if space != ColorSpace::Srgb && !rust_v::io::image::is_exr(output) {
+        return Err(Error::Settings(format!(
+            "--color-space {} needs an .exr output; {} is a PNG, always sRGB",
+            space.name(),
+            output.display()
+        )));
     }
     Ok(())
 }
@@ -171,4 +223,76 @@ fn check_output_extension(output: &Path) -> Result<()> {
         Some(e) if e == "png" || e == "exr" => Ok(()),
         _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", output.display()))),
     }
+}
+
+/// The checks before a render (see the module docs): outputs creatable and
+/// distinct from every input and from each other, snapshot names legal and
+/// free, the film within memory; warns when an emitter is brighter than the
+/// film's sample range.
+fn check_files(
+    scene_path: &Path,
+    scene: &Scene,
+    extra_inputs: &[(&str, &Path)],
+    output: &Path,
+    checkpoint: &Path,
+    spectral: bool,
+) -> Result<()> {
+    check_output(output, "image")?;
+    check_output(checkpoint, "checkpoint")?;
+    let mut inputs: Vec<(&str, &Path)> = vec![("scene", scene_path)];
+    inputs.extend(scene.inputs.iter().map(|p| ("file the scene reads", p.as_path())));
+    inputs.extend_from_slice(extra_inputs);
+    let outputs = [("image", output), ("checkpoint", checkpoint)];
+    check_aliasing(&inputs, &outputs)?;
+    // Snapshots: `stem-NNNNN.png` beside the image, up to ten digits.
+    let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    if stem.len() + "-4294967295.png".len() > NAME_MAX {
+        return Err(Error::Settings(format!(
+            "image {}: its snapshots (`{stem}-00128.png`) would have names longer than {NAME_MAX} bytes; choose a shorter name",
+            output.display()
+        )));
+    }
+    let dir = std::fs::canonicalize(parent_dir(output)).ok();
+    for (role, path) in inputs.iter().chain(&outputs[1..]) {
+        let same_dir = std::fs::canonicalize(parent_dir(path)).ok() == dir;
+        if same_dir && path.file_name().is_some_and(|n| is_snapshot_name(n, &stem)) {
+            return Err(Error::Settings(format!(
+                "{role} {} has the name of a snapshot of {}: a snapshot would overwrite it",
+                path.display(),
+                output.display()
+            )));
+        }
+    }
+    check_memory(scene.settings.width, scene.settings.height, spectral)?;
+    for (i, light) in scene.lights.iter().enumerate() {
+        let peak = light.spectrum().max_value();
+        if peak > MAX_SAMPLE {
+            warn(format_args!(
+                "light {i} emits up to {peak:e}, beyond the film's sample range ±{MAX_SAMPLE:e}: pixels that see it directly are clamped"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a film larger than the memory this machine has available (Linux:
+/// `MemAvailable` in /proc/meminfo; elsewhere not checked).
+fn check_memory(width: u32, height: u32, spectral: bool) -> Result<()> {
+    let need = Film::bytes_needed(width, height, spectral);
+    let Some(available) = available_memory() else { return Ok(()) };
+    if need > available {
+        return Err(Error::Settings(format!(
+            "a {width}x{height} render needs about {:.1} GB of memory; this machine has {:.1} GB available",
+            need as f64 / 1e9,
+            available as f64 / 1e9
+        )));
+    }
+    Ok(())
+}
+
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }

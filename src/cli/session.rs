@@ -1,24 +1,32 @@
 //! A render session: the render loop of `render` and `resume` with signals,
 //! PNG snapshots, checkpoints and the final outputs.
 //!
-//! Signal handlers only set flags (`signal_hook::flag::register`); all I/O
-//! happens on the main thread between batches of passes (one pass for
-//! images of 256 tiles or more, up to 16 for small ones: [`rust_v::render`]),
-//! in the renderer's `on_pass` callback, so snapshots and checkpoints always
-//! hold whole passes:
+//! Signal handlers only set flags (`signal_hook::flag`); all I/O happens on
+//! the main thread between batches of passes (one pass for images of 256
+//! tiles or more, up to 16 for small ones: [`rust_v::render`]), in the
+//! renderer's `on_pass` callback, so snapshots and checkpoints always hold
+//! whole passes:
 //! - SIGUSR1: a PNG snapshot `NAME-00128.png` (passes so far), then go on.
 //! - SIGUSR2: a checkpoint, then go on.
-//! - SIGINT, SIGTERM: set the renderer's stop flag, which its tile loop
-//!   checks, so unfinished passes are abandoned after the tiles in flight;
-//!   then write both and exit 0. Further SIGINTs only set the flag again:
-//!   they cannot interrupt the saving. Every file is written atomically
-//!   ([`rust_v::io::atomic_file`]), so even `kill -9` mid-write leaves the old
-//!   or the new file, never a torn one.
+//! - SIGINT, SIGTERM: while the scene loads (nothing to save yet) they end
+//!   the process at once (exit status 130 or 143). Once rendering starts they
+//!   set the renderer's stop flag, which its tile loop checks, so unfinished
+//!   passes are abandoned after the tiles in flight; then the snapshot and
+//!   the checkpoint are written and the process exits 0. Further signals
+//!   only set the flag again: they cannot interrupt the saving. Every file is
+//!   written atomically ([`rust_v::io::write_atomic`]), so even `kill -9`
+//!   mid-write leaves the old or the new file, never a torn one.
+//!
+//! Finished work is never lost to a failing disk: when the final image
+//! cannot be written (disk full, directory removed, permissions changed
+//! during the render), the passes go to the checkpoint, or if that fails too
+//! to a checkpoint in the system's temporary directory, and the error says
+//! where they are and how to continue.
 //!
 //! Signals that arrive faster than batches complete coalesce: one snapshot
 //! or checkpoint per batch at most.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -31,7 +39,7 @@ use rust_v::film::Film;
 use rust_v::render::{Limits, render};
 use rust_v::scene::Scene;
 
-use super::console::{ProgressBar, report, thread_pool};
+use super::console::{ProgressView, report, thread_pool};
 
 /// Where a session writes and how it runs.
 pub struct SessionPlan {
@@ -45,7 +53,7 @@ pub struct SessionPlan {
     pub every: Option<Duration>,
     /// Worker threads (default: all cores).
     pub threads: Option<u32>,
-    /// No progress or notes on stderr.
+    /// No progress or notes on stderr (warnings still print).
     pub quiet: bool,
     /// Stop after this much render time, in whole passes (`render --time`).
     pub budget: Option<Duration>,
@@ -56,28 +64,40 @@ pub struct Session {
     snapshot: Arc<AtomicBool>,
     checkpoint: Arc<AtomicBool>,
     stop: Arc<AtomicBool>,
+    /// While set, SIGINT and SIGTERM end the process at once (loading).
+    exit_on_stop: Arc<AtomicBool>,
     ids: Vec<SigId>,
 }
 
 impl Session {
-    /// Registers the signal handlers.
+    /// Registers the signal handlers; until [`Session::run`] starts
+    /// rendering, SIGINT and SIGTERM end the process at once.
     pub fn start() -> Result<Session> {
-        let mut s =
-            Session { snapshot: Arc::default(), checkpoint: Arc::default(), stop: Arc::default(), ids: Vec::new() };
-        let mut register = |signal: i32, flag: &Arc<AtomicBool>| -> Result<()> {
-            let id = signal_hook::flag::register(signal, Arc::clone(flag))
-                .map_err(|e| Error::Settings(format!("cannot install a handler for signal {signal}: {e}")))?;
-            s.ids.push(id);
-            Ok(())
+        let mut s = Session {
+            snapshot: Arc::default(),
+            checkpoint: Arc::default(),
+            stop: Arc::default(),
+            exit_on_stop: Arc::new(AtomicBool::new(true)),
+            ids: Vec::new(),
+        };
+        let cannot = |signal: i32, e: std::io::Error| {
+            Error::Settings(format!("cannot install a handler for signal {signal}: {e}"))
         };
         use signal_hook::consts::{SIGINT, SIGTERM};
-        register(SIGINT, &s.stop)?;
-        register(SIGTERM, &s.stop)?;
+        for (signal, status) in [(SIGINT, 130), (SIGTERM, 143)] {
+            let id = signal_hook::flag::register_conditional_shutdown(signal, status, Arc::clone(&s.exit_on_stop))
+                .map_err(|e| cannot(signal, e))?;
+            s.ids.push(id);
+            let id = signal_hook::flag::register(signal, Arc::clone(&s.stop)).map_err(|e| cannot(signal, e))?;
+            s.ids.push(id);
+        }
         #[cfg(unix)]
         {
             use signal_hook::consts::{SIGUSR1, SIGUSR2};
-            register(SIGUSR1, &s.snapshot)?;
-            register(SIGUSR2, &s.checkpoint)?;
+            for (signal, flag) in [(SIGUSR1, &s.snapshot), (SIGUSR2, &s.checkpoint)] {
+                let id = signal_hook::flag::register(signal, Arc::clone(flag)).map_err(|e| cannot(signal, e))?;
+                s.ids.push(id);
+            }
         }
         Ok(s)
     }
@@ -88,8 +108,10 @@ impl Session {
         let pool = thread_pool(plan.threads)?;
         let mut film = std::mem::replace(&mut ckpt.film, Film::new(0, 0));
         let start = film.pass_range().end;
-        let mut bar = ProgressBar::new(plan.quiet, plan.budget);
+        let mut view = ProgressView::new(plan.quiet, plan.budget);
         let mut last_checkpoint = Instant::now();
+        // From here on a stop signal saves the work instead of ending the process.
+        self.exit_on_stop.store(false, Ordering::SeqCst);
         let stats = pool.install(|| {
             render(
                 scene,
@@ -97,38 +119,46 @@ impl Session {
                 start..end.max(start),
                 Limits { stop: &self.stop, time_budget: plan.budget },
                 &mut |film, progress| {
-                    bar.update(progress);
+                    view.update(progress);
                     if self.snapshot.swap(false, Ordering::SeqCst) {
-                        let r = write_snapshot(film, plan);
-                        note(&mut bar, plan.quiet, r);
+                        tell(&view, write_snapshot(film, plan));
                     }
                     let due = plan.every.is_some_and(|d| last_checkpoint.elapsed() >= d);
                     if self.checkpoint.swap(false, Ordering::SeqCst) || due {
-                        let r = write_checkpoint(&ckpt, film, plan);
-                        note(&mut bar, plan.quiet, r);
+                        tell(&view, write_checkpoint(&ckpt, film, &plan.checkpoint_path));
                         last_checkpoint = Instant::now();
                     }
                 },
             )
         });
-        bar.finish();
+        view.finish();
         ckpt.film = film;
         let stopped = self.stop.load(Ordering::SeqCst);
         if stopped {
-            let snapshot = write_snapshot(&ckpt.film, plan)?;
-            let checkpoint = write_checkpoint(&ckpt, &ckpt.film, plan)?;
-            if !plan.quiet {
-                eprintln!("rust-v: stopped by a signal: {snapshot}; {checkpoint}");
-                eprintln!("rust-v: continue with: rust-v resume {}", plan.checkpoint_path.display());
+            // The checkpoint matters more than the snapshot: a failed snapshot is a warning.
+            let snapshot = write_snapshot(&ckpt.film, plan);
+            if let Err(e) = &snapshot {
+                view.warn(format_args!("{e}"));
             }
+            let saved = save_work(&ckpt, plan, None)?;
+            if let Ok(msg) = snapshot {
+                view.note(format_args!("stopped by a signal: {msg}"));
+            }
+            view.note(format_args!("continue with: rust-v resume {}", saved.display()));
         }
         if !stats.interrupted {
-            ckpt.film.write(&plan.output)?;
+            if let Err(e) = ckpt.film.write(&plan.output) {
+                let saved = save_work(&ckpt, plan, Some(&e))?;
+                return Err(Error::Settings(format!(
+                    "{e}; the render's {} passes are saved in {}: continue with `rust-v resume {} -o OTHER.png`",
+                    ckpt.film.passes(),
+                    saved.display(),
+                    saved.display()
+                )));
+            }
             if plan.final_checkpoint && !stopped {
-                let msg = write_checkpoint(&ckpt, &ckpt.film, plan)?;
-                if !plan.quiet {
-                    eprintln!("rust-v: {msg}");
-                }
+                let saved = save_work(&ckpt, plan, None)?;
+                view.note(format_args!("wrote checkpoint {}", saved.display()));
             }
             report(scene, &stats, &plan.output, plan.quiet);
         }
@@ -144,20 +174,45 @@ impl Drop for Session {
     }
 }
 
-/// Prints a note or a warning between progress bar lines. A failed write
-/// during the render does not stop it: the next attempt may succeed.
-fn note(bar: &mut ProgressBar, quiet: bool, r: Result<String>) {
+/// Prints a note, or a warning for a failed write during the render (which
+/// does not stop it: the next attempt may succeed).
+fn tell(view: &ProgressView, r: Result<String>) {
     match r {
-        Ok(msg) if !quiet => {
-            bar.finish();
-            eprintln!("rust-v: {msg}");
+        Ok(msg) => view.note(format_args!("{msg}")),
+        Err(e) => view.warn(format_args!("{e}")),
+    }
+}
+
+/// Writes the checkpoint where the plan says, or failing that to the
+/// system's temporary directory; returns where it went. Fails only when
+/// neither can be written, naming both errors (and `cause`, the failure
+/// that made saving necessary).
+fn save_work(ckpt: &Checkpoint, plan: &SessionPlan, cause: Option<&Error>) -> Result<PathBuf> {
+    let first = match ckpt.write_with(&ckpt.film, &plan.checkpoint_path) {
+        Ok(_) => return Ok(plan.checkpoint_path.clone()),
+        Err(e) => e,
+    };
+    let fallback = fallback_path(&plan.checkpoint_path);
+    match ckpt.write_with(&ckpt.film, &fallback) {
+        Ok(_) => {
+            super::console::warn(format_args!("{first}; the checkpoint went to {} instead", fallback.display()));
+            Ok(fallback)
         }
-        Ok(_) => {}
-        Err(e) => {
-            bar.finish();
-            eprintln!("rust-v: warning: {e}");
+        Err(second) => {
+            let cause = cause.map(|c| format!("{c}; ")).unwrap_or_default();
+            Err(Error::Settings(format!(
+                "{cause}{first}; {second}: the render's {} passes could not be saved anywhere",
+                ckpt.film.passes()
+            )))
         }
     }
+}
+
+/// `$TMPDIR/NAME-PID.ckpt`: where a checkpoint goes when its own place fails.
+fn fallback_path(checkpoint: &Path) -> PathBuf {
+    let stem = checkpoint.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "render".into());
+    let stem: String = stem.chars().take(200).collect();
+    std::env::temp_dir().join(format!("{stem}-{}.ckpt", std::process::id()))
 }
 
 fn write_snapshot(film: &Film, plan: &SessionPlan) -> Result<String> {
@@ -166,13 +221,13 @@ fn write_snapshot(film: &Film, plan: &SessionPlan) -> Result<String> {
     Ok(format!("wrote snapshot {} ({} passes)", path.display(), film.passes()))
 }
 
-fn write_checkpoint(ckpt: &Checkpoint, film: &Film, plan: &SessionPlan) -> Result<String> {
+fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<String> {
     let t = Instant::now();
-    let size = ckpt.write_with(film, &plan.checkpoint_path)?;
+    let size = ckpt.write_with(film, path)?;
     let r = film.pass_range();
     Ok(format!(
         "wrote checkpoint {} (passes {}..{}, {:.2} MB in {:.0} ms)",
-        plan.checkpoint_path.display(),
+        path.display(),
         r.start,
         r.end,
         size as f64 / 1e6,

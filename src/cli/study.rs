@@ -15,7 +15,7 @@ use rust_v::study::converge::{self, Method, Record, SUMMARY_METRICS, Schedule, S
 use rust_v::study::metrics::{Image, Metrics, Ratios, Source, THESIS_L, firefly_share, measure};
 
 use super::args::{CompareArgs, ConvergeArgs};
-use super::console::thread_pool;
+use super::console::{out, say, thread_pool};
 
 /// Reads both images and measures `a` against `b`; errors name the file(s).
 fn compare_files(a: &Path, b: &Path) -> Result<(Image, Image, Metrics)> {
@@ -98,37 +98,43 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
         for (k, v) in fields {
             let _ = write!(s, ", \"{k}\": {}", json_num(v));
         }
-        s.push('}');
-        println!("{s}");
-        return Ok(());
+        s.push_str("}\n");
+        return out(&s);
     }
-    println!("A: {} ({})", args.a.display(), describe(ia.source));
-    println!("B: {} ({}) [reference]", args.b.display(), describe(ib.source));
-    println!("size: {}x{}", ia.width, ia.height);
-    println!("thesis metrics (16-bit sRGB codes, pixel = RGB vector, L = {THESIS_L:.4}):");
-    println!("  MSE       {:.6e}   (eq. 4.6, mean squared Euclidean RGB distance)", m.mse);
-    println!("  PSNR      {:.4} dB  (eq. 4.7)", m.psnr);
-    println!("  SSIM      {:.6}   (eq. 4.8, global, on pixel magnitudes, k1 = 0.01, k2 = 0.03)", m.ssim);
-    println!("  variance  {:.6e}   (variance of the per-pixel error distance, Figure 5.2d)", m.variance);
-    println!("standard:");
-    println!(
-        "  SSIM      {:.6}   (Wang et al. 2004: 11x11 Gaussian, sigma 1.5, per channel, L = 65535)",
-        m.ssim_windowed
-    );
-    println!("linear sRGB (as the Mitsuba harness):");
-    println!("  MSE       {:.6e}   (mean over pixels and channels of squared difference)", m.mse_lin);
-    println!("  PSNR      {:.4} dB  (peak 1)", m.psnr_lin);
-    println!("  relMSE    {:.6e}   (mean of d^2 / (ref^2 + 0.01))", m.relmse);
-    println!(
+    let mut o = String::new();
+    // Appends a line to the report (writing to a String cannot fail).
+    macro_rules! w {
+        ($($t:tt)*) => {
+            let _ = writeln!(o, $($t)*);
+        };
+    }
+    w!("A: {} ({})", args.a.display(), describe(ia.source));
+    w!("B: {} ({}) [reference]", args.b.display(), describe(ib.source));
+    w!("size: {}x{}", ia.width, ia.height);
+    w!("thesis metrics (16-bit sRGB codes, pixel = RGB vector, L = {THESIS_L:.4}):");
+    w!("  MSE       {:.6e}   (eq. 4.6, mean squared Euclidean RGB distance)", m.mse);
+    w!("  PSNR      {:.4} dB  (eq. 4.7)", m.psnr);
+    w!("  SSIM      {:.6}   (eq. 4.8, global, on pixel magnitudes, k1 = 0.01, k2 = 0.03)", m.ssim);
+    w!("  variance  {:.6e}   (variance of the per-pixel error distance, Figure 5.2d)", m.variance);
+    w!("standard:");
+    w!("  SSIM      {:.6}   (Wang et al. 2004: 11x11 Gaussian, sigma 1.5, per channel, L = 65535)", m.ssim_windowed);
+    w!("linear sRGB (as the Mitsuba harness):");
+    w!("  MSE       {:.6e}   (mean over pixels and channels of squared difference)", m.mse_lin);
+    w!("  PSNR      {:.4} dB  (peak 1)", m.psnr_lin);
+    w!("  relMSE    {:.6e}   (mean of d^2 / (ref^2 + 0.01))", m.relmse);
+    w!(
         "  mean relative error |mean_A - mean_B| / mean_B: luminance {:.4e}, R {:.4e}, G {:.4e}, B {:.4e}",
-        m.rel_err_luminance, m.rel_err_rgb[0], m.rel_err_rgb[1], m.rel_err_rgb[2]
+        m.rel_err_luminance,
+        m.rel_err_rgb[0],
+        m.rel_err_rgb[1],
+        m.rel_err_rgb[2]
     );
-    println!(
+    w!(
         "  firefly share {:.4e} (reference {:.4e})   (share of total luminance in the brightest 0.1% of pixels)",
         m.firefly,
         firefly_share(&ib.linear)
     );
-    Ok(())
+    out(&o)
 }
 
 /// The default schedule: 1, 2, 4, ... below `spp`, then `spp`.
@@ -165,7 +171,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
     let out_dir = args.out.clone().unwrap_or_else(|| PathBuf::from("."));
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     let name = args.scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-    let pool = thread_pool(args.threads)?;
+    let pool = thread_pool(args.run.threads)?;
     let stop = AtomicBool::new(false);
     let base_seed = scene.settings.seed;
     let mut records: Vec<Record> = Vec::new();
@@ -173,11 +179,11 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
         for k in 0..args.seeds as u64 {
             method.apply(&mut scene);
             scene.settings.seed = base_seed.wrapping_add(k);
-            let quiet = args.quiet;
+            let quiet = args.run.quiet;
             let mut print = |r: &Record| {
                 if !quiet {
-                    eprintln!(
-                        "rust-v: {name} {:8} seed {:3} spp {:6} {:9.3} s  MSE {:.4e}  PSNR {:7.3} dB  SSIM {:.5}  mse_lin {:.4e}",
+                    say(format_args!(
+                        "{name} {:8} seed {:3} spp {:6} {:9.3} s  MSE {:.4e}  PSNR {:7.3} dB  SSIM {:.5}  mse_lin {:.4e}",
                         r.method,
                         r.seed,
                         r.spp,
@@ -186,7 +192,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
                         r.metrics.psnr,
                         r.metrics.ssim,
                         r.metrics.mse_lin
-                    );
+                    ));
                 }
             };
             let got = pool.install(|| converge::run(&scene, method.name, &schedule, &reference, &stop, &mut print))?;
@@ -274,11 +280,11 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
         chart::draw(&file("ratios-spp"), &c, &s)?;
         written.push(file("ratios-spp.png"));
     }
-    if !args.quiet {
+    if !args.run.quiet {
         for p in &written {
-            eprintln!("rust-v: wrote {}", p.display());
+            say(format_args!("wrote {}", p.display()));
         }
-        eprintln!("rust-v: charts are written as .png and .svg");
+        say(format_args!("charts are written as .png and .svg"));
     }
     Ok(())
 }

@@ -1,23 +1,103 @@
-//! CIE 1931 2-degree colour matching functions sampled at the renderer's bins.
+//! CIE 1931 2-degree colour matching functions, and the exact colour integral of a 36-bin
+//! spectrum.
 //!
-//! [`CMF`] holds the raw tabulated x̄ ȳ z̄ at the 36 bin centres (380-730 nm at 10 nm), from
-//! colour-science 0.4.7 (`colour.MSDS_CMFS['CIE 1931 2 Degree Standard Observer']`) as
-//! tabulated in `shared/data/cmf_1931_2deg.csv`, copied verbatim without interpolation.
+//! A [`Spectrum`] holds 36 samples at 380, 390, ..., 730 nm and means the spectrum that
+//! interpolates them linearly, flat beyond the end bins (scene spec). Its colour is the
+//! continuous integral `XYZ = ∫ cmf(λ) · L(λ) dλ` over 360-830 nm. Because `L` is linear in its
+//! samples, `L(λ) = Σ_b L_b · φ_b(λ)` with `φ_b` the interpolation tent of bin `b` (the end bins'
+//! tents extended flat to 360 and 830 nm), the integral is exactly a weighted sum,
 //!
-//! [`CMF_NORMALISED`] is the same table divided by the sum of the ȳ column, so that
-//! `Spectrum::to_xyz(s) = sum_i s[i] * CMF_NORMALISED[i]` and the equal-energy spectrum of
-//! value 1 has Y = 1 exactly (to f32 precision). The bin width (10 nm) is absorbed into the
-//! normalisation, so XYZ is a plain weighted sum of bins.
+//! ```text
+//! XYZ = Σ_b W_b · L_b,    W_b = ∫ cmf(λ) · φ_b(λ) dλ / ∫ ȳ(λ) dλ,
+//! ```
 //!
-//! Consequence: a spectrally flat emitter of radiance L has Y = L. The continuous 360-830 nm
-//! integral normalised the same way (as in Mitsuba 3) gives Y = 1.001 L for the same emitter,
-//! because our 36-bin sum truncates the CMF tails and samples them coarsely; comparisons with
-//! Mitsuba should allow for this ~0.1 % difference.
+//! normalised so that a flat spectrum of 1 has Y = 1 (the tents sum to 1 everywhere). The
+//! weights [`color_weights`] are computed once from the CIE 1931 table at 1 nm over 360-830 nm
+//! (`data/cmf_1931_2deg_360_830_1nm.csv`, compiled into the crate; source: CIE 1931 standard
+//! observer as tabulated by colour-science 0.4.7, `colour.MSDS_CMFS['CIE 1931 2 Degree Standard
+//! Observer']`, see `../shared/data/SOURCES.md`). Between the 1 nm rows the CMFs are linear and so
+//! is each tent, so each 1 nm piece of `cmf · φ_b` is a quadratic, integrated exactly by
+//! Simpson's rule in f64: the weights are the exact integral of the tabulated, linearly
+//! interpolated CMFs, rounded once to f32.
+//!
+//! [`CMF`] keeps the raw table values at the 36 bin centres (the point samples the renderer used
+//! before the exact integral, 3% off in the weak channel of saturated colours).
+
+use std::sync::LazyLock;
 
 use super::rgb::Xyz;
-use super::spectrum::{N_BINS, Spectrum};
+use super::spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Spectrum};
 
-/// CIE 1931 2-degree x̄ ȳ z̄ at the 36 bin centres (raw table values).
+/// The CIE 1931 2-degree table at 1 nm, 360-830 nm: `wavelength_nm,x_bar,y_bar,z_bar`.
+const CMF_1NM_CSV: &str = include_str!("data/cmf_1931_2deg_360_830_1nm.csv");
+
+/// The first and last wavelength of the colour integral, in nm.
+pub const INTEGRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
+
+/// The 1 nm table as rows `(λ, [x̄, ȳ, z̄])`. The table is compiled in and checked by the tests,
+/// so a malformed row is a build defect, not user input: it is skipped (and a test fails).
+fn cmf_1nm() -> Vec<(f64, [f64; 3])> {
+    CMF_1NM_CSV
+        .lines()
+        .skip(1)
+        .filter_map(|line| {
+            let v: Vec<f64> = line.split(',').filter_map(|c| c.trim().parse().ok()).collect();
+            (v.len() == 4).then(|| (v[0], [v[1], v[2], v[3]]))
+        })
+        .collect()
+}
+
+/// The interpolation tent of bin `b` at `lambda_nm`: 1 at the bin centre, falling linearly to 0
+/// at the neighbouring centres; the first and last bins are 1 beyond their centres.
+pub fn tent(b: usize, lambda_nm: f64) -> f64 {
+    let x = (lambda_nm - LAMBDA_MIN_NM as f64) / LAMBDA_STEP_NM as f64 - b as f64;
+    if (b == 0 && x <= 0.0) || (b == N_BINS - 1 && x >= 0.0) { 1.0 } else { (1.0 - x.abs()).max(0.0) }
+}
+
+/// Per-bin weights `W_b = ∫ cmf · φ_b` from any piecewise-linear CMF table (rows `(λ, [x̄, ȳ,
+/// z̄])` in increasing λ), each 1-row piece integrated exactly by Simpson's rule, normalised so
+/// the weights' Y sum to 1. Rows need not be 1 nm apart, but every bin centre must be a row
+/// (true for 1 nm and 5 nm tables) so that each piece is a quadratic.
+pub fn tent_weights(table: &[(f64, [f64; 3])]) -> [[f64; 3]; N_BINS] {
+    let mut w = [[0.0f64; 3]; N_BINS];
+    for pair in table.windows(2) {
+        let ((l0, c0), (l1, c1)) = (pair[0], pair[1]);
+        let lm = 0.5 * (l0 + l1);
+        let h = l1 - l0;
+        for (b, wb) in w.iter_mut().enumerate() {
+            let (t0, tm, t1) = (tent(b, l0), tent(b, lm), tent(b, l1));
+            if t0 == 0.0 && tm == 0.0 && t1 == 0.0 {
+                continue;
+            }
+            for k in 0..3 {
+                let cm = 0.5 * (c0[k] + c1[k]);
+                wb[k] += h / 6.0 * (c0[k] * t0 + 4.0 * cm * tm + c1[k] * t1);
+            }
+        }
+    }
+    let y: f64 = w.iter().map(|r| r[1]).sum();
+    for r in &mut w {
+        for v in r.iter_mut() {
+            *v /= y;
+        }
+    }
+    w
+}
+
+/// The exact colour weights in f64 (see the module doc), for fitting and tests.
+pub fn color_weights_f64() -> &'static [[f64; 3]; N_BINS] {
+    static W: LazyLock<[[f64; 3]; N_BINS]> = LazyLock::new(|| tent_weights(&cmf_1nm()));
+    &W
+}
+
+/// The exact colour weights `W_b` (x, y, z per bin; see the module doc):
+/// `XYZ = Σ_b W_b · L_b` is the continuous colour integral of the interpolated spectrum.
+pub fn color_weights() -> &'static [[f32; 3]; N_BINS] {
+    static W: LazyLock<[[f32; 3]; N_BINS]> = LazyLock::new(|| color_weights_f64().map(|r| r.map(|v| v as f32)));
+    &W
+}
+
+/// CIE 1931 2-degree x̄ ȳ z̄ at the 36 bin centres (raw table values, not the colour weights).
 ///
 /// Source: CIE 1931 2-degree CMFs, 380-730 nm at 10 nm, from colour-science 0.4.7 as tabulated
 /// in shared/data/cmf_1931_2deg.csv.
@@ -61,51 +141,25 @@ pub const CMF: [[f32; 3]; N_BINS] = [
     [0.001439971, 0.00052, 0.0],         // 730 nm
 ];
 
-/// Divides every entry of `cmf` by the sum of its ȳ column (summed in f64).
-const fn normalise_cmf(cmf: &[[f32; 3]; N_BINS]) -> [[f32; 3]; N_BINS] {
-    let mut sum_y = 0.0f64;
-    let mut i = 0;
-    while i < N_BINS {
-        sum_y += cmf[i][1] as f64;
-        i += 1;
-    }
-    let mut out = [[0.0f32; 3]; N_BINS];
-    let mut i = 0;
-    while i < N_BINS {
-        let mut k = 0;
-        while k < 3 {
-            out[i][k] = (cmf[i][k] as f64 / sum_y) as f32;
-            k += 1;
-        }
-        i += 1;
-    }
-    out
-}
-
-/// The CMF rows scaled so that sum over bins of row.y == 1 exactly (to f32 precision):
-/// `Spectrum::to_xyz(s) = sum_i s[i] * CMF_NORMALISED[i]`. Normalisation: the equal-energy
-/// spectrum of value 1 has Y = 1.
-pub const CMF_NORMALISED: [[f32; 3]; N_BINS] = normalise_cmf(&CMF);
-
-/// XYZ of bin i alone (`CMF_NORMALISED[i]` as [`Xyz`]), used by wavelength-sampling
-/// integrators. Panics if `i >= N_BINS` (an internal index, never user input).
+/// XYZ of bin i alone (`color_weights()[i]` as [`Xyz`]): the colour one unit of radiance in
+/// bin `i` adds, used by wavelength-sampling integrators. Panics if `i >= N_BINS` (an internal
+/// index, never user input).
 #[inline]
 pub fn bin_xyz(i: usize) -> Xyz {
-    let [x, y, z] = CMF_NORMALISED[i];
+    let [x, y, z] = color_weights()[i];
     Xyz::new(x, y, z)
 }
 
 impl Spectrum {
-    /// CIE XYZ of this spectrum: `sum_i self[i] * CMF_NORMALISED[i]`.
-    ///
-    /// With this normalisation the equal-energy spectrum of value 1 has Y = 1.
+    /// CIE XYZ of this spectrum, the exact integral of its linear interpolation:
+    /// `Σ_b self[b] · W_b` ([`color_weights`]). A flat spectrum of 1 has Y = 1.
     #[inline]
     pub fn to_xyz(&self) -> Xyz {
         let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
-        for (&s, cmf) in self.0.iter().zip(CMF_NORMALISED.iter()) {
-            x += s * cmf[0];
-            y += s * cmf[1];
-            z += s * cmf[2];
+        for (&s, w) in self.0.iter().zip(color_weights().iter()) {
+            x += s * w[0];
+            y += s * w[1];
+            z += s * w[2];
         }
         Xyz::new(x, y, z)
     }
@@ -161,23 +215,79 @@ mod tests {
     }
 
     #[test]
-    fn normalised_y_sums_to_one() {
-        let sum: f32 = CMF_NORMALISED.iter().map(|r| r[1]).sum();
-        // f32 summation of 36 values each rounded to 0.5 ulp: error well below 1e-6.
-        assert!((sum - 1.0).abs() < 1e-6, "sum = {sum}");
+    fn weights_y_sum_to_one_and_table_is_whole() {
+        // 471 rows, 360..=830 nm at 1 nm: a malformed row would be skipped silently otherwise.
+        let t = cmf_1nm();
+        assert_eq!(t.len(), 471);
+        assert!(t.iter().enumerate().all(|(i, r)| r.0 == 360.0 + i as f64));
+        let sum: f64 = color_weights_f64().iter().map(|r| r[1]).sum();
+        assert!((sum - 1.0).abs() < 1e-12, "sum = {sum}");
         let y = Spectrum::ONE.to_xyz().y;
+        // f32 sum of 36 products: a few ulps.
         assert!((y - 1.0).abs() < 1e-6, "Y(E) = {y}");
     }
 
+    /// The continuous integral of the 1 nm CMFs gives X = Y = Z for the equal-energy spectrum
+    /// up to the table's own rounding (the CIE defines them equal): x = y = 1/3 within 1e-4.
     #[test]
     fn equal_energy_chromaticity() {
         let e = Spectrum::ONE.to_xyz();
         let s = e.x + e.y + e.z;
-        // The continuous integrals of x̄ ȳ z̄ are equal by definition, giving x = y = 1/3. The
-        // 10 nm sum over 380-730 nm truncates and coarsely samples them, so allow 2e-3
-        // (measured: x = 0.33336, y = 0.33345).
-        assert!((e.x / s - 1.0 / 3.0).abs() < 2e-3, "x = {}", e.x / s);
-        assert!((e.y / s - 1.0 / 3.0).abs() < 2e-3, "y = {}", e.y / s);
+        assert!((e.x / s - 1.0 / 3.0).abs() < 1e-4, "x = {}", e.x / s);
+        assert!((e.y / s - 1.0 / 3.0).abs() < 1e-4, "y = {}", e.y / s);
+    }
+
+    /// The colour integral computed independently: the 36-bin spectrum interpolated linearly at
+    /// every 1 nm row (flat beyond 380 and 730 nm), times the tabulated CMFs, summed by the
+    /// trapezoidal rule, divided by the same sum of ȳ. Reads the table through its own parser.
+    fn integral_1nm(s: &Spectrum) -> [f64; 3] {
+        let mut acc = [0.0f64; 3];
+        let mut y = 0.0f64;
+        let rows: Vec<Vec<f64>> =
+            CMF_1NM_CSV.lines().skip(1).map(|l| l.split(',').map(|c| c.parse::<f64>().unwrap()).collect()).collect();
+        for (i, r) in rows.iter().enumerate() {
+            let end = if i == 0 || i == rows.len() - 1 { 0.5 } else { 1.0 };
+            let pos = ((r[0] - 380.0) / 10.0).clamp(0.0, 35.0);
+            let i0 = (pos.floor() as usize).min(34);
+            let f = pos - i0 as f64;
+            let v = s[i0] as f64 * (1.0 - f) + s[i0 + 1] as f64 * f;
+            for k in 0..3 {
+                acc[k] += end * v * r[k + 1];
+            }
+            y += end * r[2];
+        }
+        acc.map(|a| a / y)
+    }
+
+    /// Part 1's acceptance test: every ColorChecker patch under D65 and under E, XYZ within 0.05%
+    /// of the independent 1 nm integral in every channel. The trapezoidal rule at 1 nm differs
+    /// from the exact integral of the piecewise-quadratic integrand by h²/12 · f'' ≈ 1e-5
+    /// relative; the old point-sampled sum was off by up to 3% (the test fails on it).
+    #[test]
+    fn color_checker_matches_1nm_integral() {
+        use crate::color::{COLOR_CHECKER_NAMES, color_checker, d65, equal_energy};
+        let mut worst = 0.0f64;
+        for light in [d65(), equal_energy()] {
+            for name in COLOR_CHECKER_NAMES {
+                let s = color_checker(name).unwrap() * light;
+                let got = s.to_xyz();
+                let want = integral_1nm(&s);
+                for (g, w) in [got.x, got.y, got.z].into_iter().zip(want) {
+                    let rel = (g as f64 - w).abs() / w;
+                    worst = worst.max(rel);
+                    assert!(rel < 5e-4, "{name}: {g} vs {w} ({rel:e})");
+                }
+            }
+        }
+        eprintln!("worst relative difference: {worst:e}");
+    }
+
+    #[test]
+    fn tents_partition_unity() {
+        for l in 360..=830 {
+            let s: f64 = (0..N_BINS).map(|b| tent(b, l as f64 + 0.3)).sum();
+            assert!((s - 1.0).abs() < 1e-12, "{l}: {s}");
+        }
     }
 
     #[test]

@@ -325,21 +325,21 @@ mod tests {
     fn d65_white_point() {
         let xyz = d65().to_xyz();
         let (x, y) = xyz.chromaticity();
-        // CIE D65 white point (0.31271, 0.32902) from the continuous 1 nm tables; our 10 nm
-        // sum gives (0.312716, 0.329134), 1.1e-4 away, inside the 1e-3 tolerance.
+        // CIE D65 white point (0.31271, 0.32902) from the continuous 1 nm tables; ours is the
+        // exact colour integral of the 10 nm D65 samples interpolated linearly, which differs
+        // from the 1 nm D65 between the samples: allow 1e-3 (D65 -> sRGB white is checked to 1e-4
+        // below).
         assert!((x - 0.31271).abs() < 1e-3, "x = {x}");
         assert!((y - 0.32902).abs() < 1e-3, "y = {y}");
     }
 
     #[test]
     fn d65_maps_to_srgb_white() {
-        // sRGB's white is D65, so D65 at Y = 1 must give linear (1, 1, 1). Tolerance 1e-3 per
-        // channel (the requirement); measured deviation with the 10 nm tables:
-        // r 0.99920, g 1.00030, b 0.99935, i.e. at most 8.0e-4.
+        // sRGB's white is D65, so D65 at Y = 1 must give linear (1, 1, 1) within 1e-4.
         let xyz = d65().to_xyz();
         let rgb = (xyz * (1.0 / xyz.y)).to_linear_srgb();
         for (c, v) in [("r", rgb.r), ("g", rgb.g), ("b", rgb.b)] {
-            assert!((v - 1.0).abs() < 1e-3, "{c} = {v}");
+            assert!((v - 1.0).abs() < 1e-4, "{c} = {v}");
         }
         let w = reflectance_to_xyz(&Spectrum::ONE, &d65());
         assert!((w.y - 1.0).abs() < 1e-6);

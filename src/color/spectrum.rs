@@ -115,6 +115,27 @@ impl<const N: usize> Sampled<N> {
     }
 }
 
+impl Spectrum {
+    /// The spectrum of a table of `(nm, value)` points (wavelengths increasing), linear between
+    /// the points and flat beyond the first and last, sampled at the 36 bin centres. Features
+    /// narrower than the 10 nm bins are sampled, not averaged. An empty table is zero.
+    pub fn from_table(points: &[(f32, f32)]) -> Self {
+        Spectrum::from_fn(|b| {
+            let l = bin_lambda_nm(b);
+            let k = points.partition_point(|p| p.0 <= l);
+            match (k, points.get(k)) {
+                (_, None) => points.last().map_or(0.0, |p| p.1),
+                (0, Some(p)) => p.1,
+                (k, Some(&(l1, v1))) => {
+                    let (l0, v0) = points[k - 1];
+                    let f = (l - l0) / (l1 - l0);
+                    v0 + (v1 - v0) * f
+                }
+            }
+        })
+    }
+}
+
 /// Element-wise binary operators, each with its assigning form.
 macro_rules! element_wise {
     ($($op:ident $method:ident $assign:ident $assign_method:ident $sym:tt;)+) => {$(
@@ -209,6 +230,23 @@ mod tests {
 
     fn ramp() -> Spectrum {
         Spectrum::from_fn(|i| i as f32 + 1.0)
+    }
+
+    #[test]
+    fn table_is_linear_between_points_and_flat_beyond() {
+        let s = Spectrum::from_table(&[(400.0, 0.1), (550.0, 0.8), (700.0, 0.3)]);
+        assert_eq!(s[0], 0.1); // 380 nm: flat before 400
+        assert_eq!(s[2], 0.1); // 400 nm
+        assert!((s[9] - (0.1 + 0.7 * 70.0 / 150.0)).abs() < 1e-6); // 470 nm
+        assert_eq!(s[17], 0.8); // 550 nm
+        assert!((s[26] - (0.8 - 0.5 * 90.0 / 150.0)).abs() < 1e-6); // 640 nm
+        assert_eq!(s[35], 0.3); // 730 nm: flat after 700
+        // Points exactly at the bin centres give the samples back.
+        let v = Spectrum::from_fn(|i| (i as f32 * 0.3).sin().abs());
+        let pts: Vec<(f32, f32)> = (0..N_BINS).map(|i| (bin_lambda_nm(i), v[i])).collect();
+        assert_eq!(Spectrum::from_table(&pts), v);
+        assert_eq!(Spectrum::from_table(&[]), Spectrum::ZERO);
+        assert_eq!(Spectrum::from_table(&[(555.0, 2.0)]), Spectrum::splat(2.0));
     }
 
     #[test]

@@ -29,19 +29,19 @@ use glam::{Vec2, Vec3};
 
 use crate::bxdf::Bxdf;
 use crate::color::Sampled;
-use crate::color::Xyz;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::Scene;
 use crate::settings::{IntegratorKind, Settings, WavelengthsKind};
-use crate::spectral::{Lambdas, WavelengthSampling, sample_packet};
+use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet};
 
 /// Computes the colour of one camera sample. Implementations are chosen once
 /// per render and the render loop is generic over them.
 pub(crate) trait Estimator: Sync {
-    /// The XYZ estimate of one sample through film position `film` (pixel units).
-    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz;
+    /// The estimate of one sample through film position `film` (pixel units): its XYZ, or its
+    /// per-bin radiance for spectral output.
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O;
 }
 
 /// The light-transport method, with its bounce limit.
@@ -56,7 +56,13 @@ pub(crate) enum Transport {
 impl Transport {
     /// Radiance along `ray` for the packet `lambdas`, as XYZ.
     #[inline]
-    pub fn li<const N: usize>(&self, scene: &Scene, ray: Ray, lambdas: &Lambdas<N>, sampler: &mut Sampler) -> Xyz {
+    pub fn li<const N: usize, O: Contribution>(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        lambdas: &Lambdas<N>,
+        sampler: &mut Sampler,
+    ) -> O {
         match self {
             Transport::Whitted(w) => w.li(scene, ray, lambdas, sampler),
             Transport::Path(p) => p.li(scene, ray, lambdas, sampler),
@@ -69,7 +75,7 @@ pub(crate) struct FullSpectrum(pub Transport);
 
 impl Estimator for FullSpectrum {
     #[inline]
-    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz {
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O {
         let ray = scene.camera.ray(film);
         self.0.li(scene, ray, &Lambdas::full(), sampler)
     }
@@ -80,7 +86,7 @@ pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling)
 
 impl<const C: usize> Estimator for Packets<C> {
     #[inline]
-    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz {
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O {
         let ray = scene.camera.ray(film);
         let u: [f32; C] = std::array::from_fn(|_| sampler.next_1d());
         self.0.li(scene, ray, &sample_packet::<C>(self.1, u), sampler)
@@ -92,7 +98,7 @@ pub(crate) struct RgbWavelengths(pub Transport);
 
 impl Estimator for RgbWavelengths {
     #[inline]
-    fn sample(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Xyz {
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O {
         let ray = scene.camera.ray(film);
         self.0.li(scene, ray, &Lambdas::rgb(), sampler)
     }

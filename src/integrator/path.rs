@@ -25,12 +25,12 @@
 //!    and divide `β` by `q` (unbiased).
 
 use crate::bxdf::{BsdfSample, Dispersion};
-use crate::color::{N_BINS, Sampled, Xyz};
+use crate::color::{N_BINS, Sampled};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
-use crate::spectral::{BinDistribution, Lambdas, Readout, bin_importance, for_each_rotated};
+use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated};
 
 use super::{Shading, sample_direct};
 
@@ -71,9 +71,15 @@ struct Walk<const N: usize> {
 
 impl PathTracer {
     /// Radiance arriving along `ray` for the packet `lambdas`, as XYZ.
-    pub fn li<const N: usize>(&self, scene: &Scene, ray: Ray, lambdas: &Lambdas<N>, sampler: &mut Sampler) -> Xyz {
+    pub(crate) fn li<const N: usize, O: Contribution>(
+        &self,
+        scene: &Scene,
+        ray: Ray,
+        lambdas: &Lambdas<N>,
+        sampler: &mut Sampler,
+    ) -> O {
         let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
-            return Xyz::default();
+            return O::default();
         };
         let walk = Walk {
             beta: Sampled::splat(1.0),
@@ -86,7 +92,7 @@ impl PathTracer {
 
     /// Continues a path that arrived along `ray` at `si`.
     #[allow(clippy::too_many_arguments)]
-    fn walk<const N: usize>(
+    fn walk<const N: usize, O: Contribution>(
         &self,
         scene: &Scene,
         mut ray: Ray,
@@ -95,9 +101,9 @@ impl PathTracer {
         lambdas: &Lambdas<N>,
         sampler: &mut Sampler,
         mut start: Start,
-    ) -> Xyz {
+    ) -> O {
         let mut l = Sampled::<N>::splat(0.0);
-        let mut split = Xyz::default();
+        let mut split = O::default();
         let mut add_emission = start == Start::Camera;
         loop {
             let object = &scene.objects[si.object as usize];
@@ -118,7 +124,7 @@ impl PathTracer {
                     let weight = if w.prev.delta {
                         1.0
                     } else {
-                        let pdf_light = scene.light_pmf[index as usize] * light.pdf_li(w.prev.p, ray.dir, hit.p);
+                        let pdf_light = scene.light_pmf[index as usize] * light.pdf_li(w.prev.p, ray.dir, hit.p, hit.n);
                         power_heuristic(w.prev.pdf_bsdf, pdf_light)
                     };
                     l += w.beta * lambdas.sample(light.spectrum()) * (scale * weight);
@@ -158,13 +164,13 @@ impl PathTracer {
                         let one = Walk { beta: Sampled([w.beta[bin]]), ..copy_walk(&w) };
                         let l1 =
                             Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
-                        split += self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::Split);
+                        split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::Split);
                     });
                     break;
                 } else {
                     for i in 0..N {
                         let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
-                        split += self.walk::<1>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
+                        split += self.walk::<1, O>(scene, ray, si, one, &lambdas.single(i), sampler, Start::Split);
                     }
                     break;
                 }
@@ -209,7 +215,9 @@ impl PathTracer {
                 None => break,
             }
         }
-        lambdas.xyz(&l) + split
+        let mut out = O::from_packet(lambdas, &l);
+        out += split;
+        out
     }
 }
 
@@ -236,7 +244,7 @@ impl PathTracer {
     /// reflected.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn collapse<const N: usize>(
+    fn collapse<const N: usize, O: Contribution>(
         &self,
         scene: &Scene,
         ray: Ray,
@@ -246,7 +254,7 @@ impl PathTracer {
         w: &Walk<N>,
         lambdas: &Lambdas<N>,
         sampler: &mut Sampler,
-        split: &mut Xyz,
+        split: &mut O,
     ) -> Option<Sampled<N>> {
         let importance = bin_importance();
         let cos = sh.wo.z;
@@ -279,7 +287,7 @@ impl PathTracer {
             };
             let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
-            *split += self.walk::<1>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
+            *split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
         });
         None
     }

@@ -12,11 +12,10 @@
 //! packets are the full spectrum, which a BxDF samples at that wavelength.
 
 use crate::color::Sampled;
-use crate::color::Xyz;
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectral::Lambdas;
+use crate::spectral::{Contribution, Lambdas};
 
 use super::{Shading, sample_direct};
 
@@ -29,7 +28,13 @@ pub struct Whitted {
 
 impl Whitted {
     /// Radiance arriving along `ray` for the packet `lambdas`, as XYZ.
-    pub fn li<const N: usize>(&self, scene: &Scene, mut ray: Ray, lambdas: &Lambdas<N>, sampler: &mut Sampler) -> Xyz {
+    pub(crate) fn li<const N: usize, O: Contribution>(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        lambdas: &Lambdas<N>,
+        sampler: &mut Sampler,
+    ) -> O {
         let mut l = Sampled::<N>::splat(0.0);
         let mut beta = Sampled::<N>::splat(1.0);
         let mut bounces = 0;
@@ -73,6 +78,6 @@ impl Whitted {
             bounces += 1;
             ray = Ray::spawn(hit.p, hit.n, wi);
         }
-        lambdas.xyz(&l)
+        O::from_packet(lambdas, &l)
     }
 }

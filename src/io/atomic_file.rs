@@ -10,12 +10,27 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use super::files::NAME_MAX;
+use super::hash::fnv1a;
 use crate::error::{Error, Result};
 
-/// `dir/.name.tmp-PID`: a temporary name in the same directory (so the rename is atomic).
+/// `dir/.name.tmp-PID`: a temporary name in the same directory (so the
+/// rename is atomic). When that would exceed the file system's name limit
+/// for a long but legal `name`, the name is shortened and a hash of it
+/// keeps temporary names of different files apart.
 pub fn temp_path(path: &Path) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+    let suffix = format!(".tmp-{}", std::process::id());
+    let full = format!(".{name}{suffix}");
+    if full.len() <= NAME_MAX {
+        return path.with_file_name(full);
+    }
+    let hash = format!("~{:016x}", fnv1a(name.as_bytes()));
+    let mut keep = NAME_MAX - 1 - hash.len() - suffix.len();
+    while !name.is_char_boundary(keep) {
+        keep -= 1;
+    }
+    path.with_file_name(format!(".{}{hash}{suffix}", &name[..keep]))
 }
 
 /// Replaces `path` with `bytes` atomically (see the module docs).
@@ -80,6 +95,20 @@ mod tests {
         assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1, "temporary file left behind");
         write_atomic(&path, b"new").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
+    }
+
+    #[test]
+    fn temporary_names_stay_within_the_name_limit() {
+        let short = temp_path(Path::new("d/out.png"));
+        assert_eq!(short, Path::new(&format!("d/.out.png.tmp-{}", std::process::id())));
+        for n in [200, 240, 250, 255] {
+            let name = "é".repeat(n / 2) + &"x".repeat(n % 2);
+            let t = temp_path(&Path::new("d").join(&name));
+            let len = t.file_name().unwrap().len();
+            assert!(len <= NAME_MAX, "{n}: {len}");
+        }
+        let (a, b) = ("a".repeat(250) + "1.png", "a".repeat(250) + "2.png");
+        assert_ne!(temp_path(Path::new(&a)), temp_path(Path::new(&b)));
     }
 
     #[test]

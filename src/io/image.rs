@@ -6,13 +6,14 @@
 //!   out-of-gamut values become 0; values above 1 become 1: no tone mapping,
 //!   no exposure) and encoded with the sRGB transfer curve ([`encode_u16`]).
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
-//!   unclamped, for measurements.
+//!   unclamped, for measurements; or, with `--color-space`, Rec. 2020, ACEScg or XYZ with a
+//!   `chromaticities` attribute ([`write_exr_in`]).
 
 use std::io::Cursor;
 use std::path::Path;
 
 use super::write_atomic;
-use crate::color::srgb_oetf;
+use crate::color::{ColorSpace, srgb_oetf};
 use crate::error::{Error, Result};
 
 /// True when `path` names an EXR file (by its extension, any case).
@@ -41,6 +42,68 @@ pub fn write_linear_srgb(path: &Path, width: u32, height: u32, rgb: &[[f64; 3]])
             .write_to(&mut bytes, image::ImageFormat::Png)
             .map_err(image_error)?;
     }
+    write_atomic(path, &bytes.into_inner())
+}
+
+/// Writes `width` x `height` pixels (row-major, already in `space`) as a 32-bit float EXR whose
+/// `chromaticities` attribute names the space, atomically. XYZ gets channels X, Y, Z (the
+/// OpenEXR convention, as Mitsuba writes it); the RGB spaces R, G, B.
+pub fn write_exr_in(path: &Path, width: u32, height: u32, pixels: &[[f64; 3]], space: ColorSpace) -> Result<()> {
+    write_exr(path, width, height, pixels, space, None)
+}
+
+/// The channel name of spectral bin `lambda_nm` in the layout of Fichet et al. 2021 ("An
+/// OpenEXR Layout for Spectral Images", JCGT 10(3)): emissive Stokes component 0, the
+/// wavelength with a comma as the decimal separator, then the unit: `S0.380,000000nm`.
+pub fn spectral_channel_name(lambda_nm: f32) -> String {
+    format!("S0.{:.6}nm", lambda_nm).replace('.', ",").replacen(',', ".", 1)
+}
+
+/// Writes an EXR like [`write_exr_in`] plus, when `spectral` is given (per pixel, the mean
+/// radiance of each bin at `wavelengths_nm`), one float channel per bin named as Fichet et al.
+/// 2021 specify ([`spectral_channel_name`]), with their `spectralLayoutVersion` attribute.
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f64; 3]],
+    space: ColorSpace,
+    spectral: Option<(&[f32], &[Vec<f32>])>,
+) -> Result<()> {
+    use exr::meta::attribute::{AttributeValue, Chromaticities, Text};
+    use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, Vec2, WritableImage};
+    let bad = |message: String| Error::Image { path: path.to_path_buf(), message };
+    if pixels.len() != width as usize * height as usize {
+        return Err(bad("buffer size does not match".into()));
+    }
+    let names = space.channels();
+    let mut channels: Vec<AnyChannel<FlatSamples>> = (0..3)
+        .map(|c| AnyChannel::new(names[c], FlatSamples::F32(pixels.iter().map(|p| p[c] as f32).collect())))
+        .collect();
+    let mut attributes = LayerAttributes::default();
+    if let Some((wavelengths, bins)) = spectral {
+        if bins.len() != wavelengths.len() || bins.iter().any(|b| b.len() != pixels.len()) {
+            return Err(bad("spectral buffer size does not match".into()));
+        }
+        for (l, b) in wavelengths.iter().zip(bins) {
+            channels.push(AnyChannel::new(spectral_channel_name(*l).as_str(), FlatSamples::F32(b.clone())));
+        }
+        // The layout's one required attribute. Its optional `emissiveUnits` is left out: the exr
+        // crate keeps custom attributes in a HashMap whose order changes from run to run, and
+        // with two of them the file's bytes would too (renders must be byte-reproducible).
+        attributes.other.insert(Text::from("spectralLayoutVersion"), AttributeValue::Text(Text::from("1.0")));
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels.into()),
+    );
+    let mut image = exr::image::Image::from_layer(layer);
+    let xy = space.chromaticities().map(|[x, y]| Vec2(x as f32, y as f32));
+    image.attributes.chromaticities = Some(Chromaticities { red: xy[0], green: xy[1], blue: xy[2], white: xy[3] });
+    let mut bytes = Cursor::new(Vec::new());
+    image.write().non_parallel().to_buffered(&mut bytes).map_err(|e| bad(e.to_string()))?;
     write_atomic(path, &bytes.into_inner())
 }
 
@@ -88,6 +151,13 @@ pub fn encode_u16(linear: f64) -> u16 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spectral_channel_names_follow_fichet_2021() {
+        assert_eq!(spectral_channel_name(380.0), "S0.380,000000nm");
+        assert_eq!(spectral_channel_name(435.8), "S0.435,799988nm");
+        assert_eq!(spectral_channel_name(730.0), "S0.730,000000nm");
+    }
 
     #[test]
     fn encoding_clamps_and_follows_the_transfer_curve() {

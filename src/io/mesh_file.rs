@@ -13,7 +13,11 @@ use crate::error::{Error, Result};
 
 /// Reads and decompresses a mesh file into positions, triangles and optional normals.
 pub fn read_mesh_file(path: &Path) -> Result<MeshData> {
-    let raw = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    parse_mesh(super::read_input(path)?, path)
+}
+
+/// Parses a mesh file's bytes (`path`'s name picks the format; errors name it).
+pub fn parse_mesh(raw: Vec<u8>, path: &Path) -> Result<MeshData> {
     let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
     let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
         let mut out = Vec::with_capacity(raw.len() * 4);

@@ -1,11 +1,13 @@
 //! Light sources: the closed set of emitters, one file per kind, and how
 //! each is sampled from a shading point.
 //!
-//! Area lights are scene objects with an `emission` (a sphere or a disk); they
-//! emit from their outer side only, like Mitsuba's `area` emitter, with
-//! radiance `L_e(λ)`, unless `two_sided: true` (pbrt-v4's `twosided`).
-//! A point light has intensity `I(λ)` and is a delta light. A new emitter is
-//! a new file here, a variant of [`Light`] and a case in the scene loader.
+//! Area lights are scene objects with an `emission` (a sphere, disk, quad,
+//! cuboid or mesh); they emit from their outer side only, like Mitsuba's
+//! `area` emitter, with radiance `L_e(λ)`, unless `two_sided: true`
+//! (pbrt-v4's `twosided`). The `lights:` list holds the delta lights: point
+//! and spot lights (intensity `I(λ)`), distant lights and beams (irradiance
+//! `E(λ)`). A new emitter is a new file here, a variant of [`Light`] and a
+//! case in the scene loader.
 //!
 //! Every light answers the same questions: what it emits
 //! ([`Light::spectrum`]), how much ([`Light::power`], for choosing among
@@ -19,13 +21,21 @@
 //! lights: [ Point(position: (0, 1.9, 0), intensity: Scaled(2, D65)) ],
 //! ```
 
+mod area;
+mod beam;
 mod disk;
+mod distant;
 mod point;
 mod sphere;
+mod spot;
 
+pub use area::AreaLight;
+pub use beam::BeamLight;
 pub use disk::DiskLight;
+pub use distant::DistantLight;
 pub use point::PointLight;
 pub use sphere::SphereLight;
+pub use spot::SpotLight;
 
 use glam::{Vec2, Vec3};
 
@@ -40,6 +50,14 @@ pub enum Light {
     Sphere(SphereLight),
     /// A disk area light.
     Disk(DiskLight),
+    /// A quad, cuboid or mesh area light.
+    Area(AreaLight),
+    /// A point light limited to a cone.
+    Spot(SpotLight),
+    /// Parallel light from one direction everywhere (the sun).
+    Distant(DistantLight),
+    /// A collimated beam from a disk.
+    Beam(BeamLight),
 }
 
 /// A direction towards a light from a shading point.
@@ -51,20 +69,26 @@ pub struct LightSample {
     pub point: Vec3,
     /// The pdf of `wi` per unit solid angle (1 for delta lights).
     pub pdf: f32,
-    /// Scale to apply to the light's spectrum: 1 for area lights, `1/d²` for a point light.
+    /// Scale to apply to the light's spectrum: 1 for area lights, distant
+    /// lights and beams, `1/d²` for a point light (times the falloff for a spot).
     pub scale: f32,
-    /// True for a point light (no MIS with BSDF sampling).
+    /// True for a delta light (no MIS with BSDF sampling).
     pub is_delta: bool,
 }
 
 impl Light {
-    /// The spectrum emitted: radiance for area lights, intensity for point lights.
+    /// The spectrum emitted: radiance for area lights, intensity for point
+    /// and spot lights, irradiance for distant lights and beams.
     #[inline]
     pub fn spectrum(&self) -> &Spectrum {
         match self {
             Light::Point(l) => &l.intensity,
             Light::Sphere(l) => &l.radiance,
             Light::Disk(l) => &l.radiance,
+            Light::Area(l) => &l.radiance,
+            Light::Spot(l) => &l.intensity,
+            Light::Distant(l) => &l.irradiance,
+            Light::Beam(l) => &l.irradiance,
         }
     }
 
@@ -75,6 +99,10 @@ impl Light {
             Light::Point(l) => l.power(),
             Light::Sphere(l) => l.power(),
             Light::Disk(l) => l.power(),
+            Light::Area(l) => l.power(),
+            Light::Spot(l) => l.power(),
+            Light::Distant(l) => l.power(),
+            Light::Beam(l) => l.power(),
         }
     }
 
@@ -85,17 +113,31 @@ impl Light {
             Light::Point(l) => l.sample_li(p),
             Light::Sphere(l) => l.sample_li(p, u),
             Light::Disk(l) => l.sample_li(p, u),
+            Light::Area(l) => l.sample_li(p, u),
+            Light::Spot(l) => l.sample_li(p),
+            Light::Distant(l) => l.sample_li(p),
+            Light::Beam(l) => l.sample_li(p),
         }
     }
 
     /// The pdf per unit solid angle with which [`Light::sample_li`] from `p`
-    /// would choose the direction `wi` that hits the light at `point`.
+    /// would choose the direction `wi` that hits the light at `point`, whose
+    /// geometric normal is `n` (0 for delta lights, which no ray hits).
     #[inline]
-    pub fn pdf_li(&self, p: Vec3, wi: Vec3, point: Vec3) -> f32 {
+    pub fn pdf_li(&self, p: Vec3, wi: Vec3, point: Vec3, n: Vec3) -> f32 {
         match self {
-            Light::Point(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Distant(_) | Light::Beam(_) => 0.0,
             Light::Sphere(l) => l.pdf_li(p, wi, point),
             Light::Disk(l) => l.pdf_li(p, wi, point),
+            Light::Area(l) => l.pdf_li(p, wi, point, n),
+        }
+    }
+
+    /// Tells lights that depend on the scene's size (distant lights) the
+    /// radius of a sphere around everything bounded and the camera.
+    pub fn set_scene_radius(&mut self, radius: f32) {
+        if let Light::Distant(l) = self {
+            l.scene_radius = radius;
         }
     }
 
@@ -105,9 +147,10 @@ impl Light {
     #[inline]
     pub fn le_scale(&self, n: Vec3, dir: Vec3) -> f32 {
         let two_sided = match self {
-            Light::Point(_) => return 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Distant(_) | Light::Beam(_) => return 0.0,
             Light::Sphere(l) => l.two_sided,
             Light::Disk(l) => l.two_sided,
+            Light::Area(l) => l.two_sided,
         };
         if two_sided || n.dot(dir) < 0.0 { 1.0 } else { 0.0 }
     }
@@ -120,7 +163,7 @@ fn sides(two_sided: bool) -> f32 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::geometry::{Hit, Ray};
     use crate::sampler::Sampler;
@@ -128,13 +171,13 @@ mod tests {
 
     /// ∫ pdf_li dω over all directions from `p`, estimated with `n` uniform
     /// directions; `hit` intersects the light's shape.
-    pub(super) fn pdf_integral(light: &Light, hit: impl Fn(&Ray) -> Option<Hit>, p: Vec3, seed: u64, n: usize) -> f64 {
+    pub(crate) fn pdf_integral(light: &Light, hit: impl Fn(&Ray) -> Option<Hit>, p: Vec3, seed: u64, n: usize) -> f64 {
         let mut s = Sampler::new(seed, 1, 1);
         let mut integral = 0.0f64;
         for _ in 0..n {
             let w = crate::sampler::warp::uniform_sphere(s.next_2d());
             if let Some(h) = hit(&Ray::new(p, w)) {
-                integral += light.pdf_li(p, w, h.p) as f64 * 4.0 * std::f64::consts::PI;
+                integral += light.pdf_li(p, w, h.p, h.n) as f64 * 4.0 * std::f64::consts::PI;
             }
         }
         integral / n as f64
@@ -201,13 +244,13 @@ mod stability_tests {
         for _ in 0..1000 {
             let ls = light.sample_li(p, s.next_2d()).unwrap();
             assert!(((ls.point - sphere.center).length() - sphere.radius).abs() < 1e-4);
-            let back = light.pdf_li(p, ls.wi, ls.point);
+            let back = light.pdf_li(p, ls.wi, ls.point, Vec3::ZERO);
             assert!((back - ls.pdf).abs() <= 1e-3 * ls.pdf, "{back} vs {}", ls.pdf);
         }
         // A one-sided sphere emits nothing inward: no sample, pdf 0.
         let one = Light::Sphere(SphereLight { sphere, radiance: Spectrum::ONE, two_sided: false });
         assert!(one.sample_li(p, Vec2::splat(0.3)).is_none());
-        assert_eq!(one.pdf_li(p, Vec3::X, p + Vec3::X), 0.0);
+        assert_eq!(one.pdf_li(p, Vec3::X, p + Vec3::X, Vec3::ZERO), 0.0);
     }
 
     /// A two-sided disk is sampled by area from both sides: the pdf
@@ -251,7 +294,7 @@ mod stability_tests {
                     assert!(ls.pdf.is_finite() && ls.pdf > 0.0, "r/d {ratio}: pdf {}", ls.pdf);
                     let off = ((ls.point - centre).length() - r).abs();
                     assert!(off < 1e-3 * r + 4e-6 * d, "r/d {ratio}, d {d}: point {off:e} off the sphere");
-                    let back = light.pdf_li(p, ls.wi, ls.point);
+                    let back = light.pdf_li(p, ls.wi, ls.point, Vec3::ZERO);
                     assert!((back - ls.pdf).abs() <= 1e-4 * ls.pdf);
                     e += (ls.wi.y.max(0.0) / ls.pdf) as f64;
                 }

@@ -22,7 +22,7 @@
 //! )
 //! ```
 
-use std::collections::BTreeMap;
+use std::collections::BTreeSet;
 
 use serde::Deserialize;
 
@@ -40,14 +40,43 @@ pub struct SceneDesc {
     /// Render settings; each can be overridden on the command line.
     #[serde(default)]
     pub render: SettingsPatch,
-    /// Named materials, referred to by objects.
+    /// Named materials, referred to by objects (a name may appear once).
     #[serde(default)]
-    pub materials: BTreeMap<String, MaterialDesc>,
+    pub materials: Materials,
     /// The objects (shapes with a material or an emission).
     pub objects: Vec<ObjectDesc>,
     /// Lights that are not objects (point lights).
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+}
+
+/// The `materials` map in file order; a name given twice is an error
+/// (`duplicate material "white"`), where a plain map would keep the last.
+#[derive(Debug, Default)]
+pub struct Materials(pub Vec<(String, MaterialDesc)>);
+
+impl<'de> Deserialize<'de> for Materials {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = Materials;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a map from material names to materials")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Materials, A::Error> {
+                let mut seen = BTreeSet::new();
+                let mut out = Vec::new();
+                while let Some(name) = map.next_key::<String>()? {
+                    if !seen.insert(name.clone()) {
+                        return Err(serde::de::Error::custom(format!("duplicate material \"{name}\"")));
+                    }
+                    out.push((name, map.next_value()?));
+                }
+                Ok(Materials(out))
+            }
+        }
+        d.deserialize_map(Visit)
+    }
 }
 
 /// A pinhole camera.
@@ -86,6 +115,19 @@ pub enum SpectrumDesc {
     Blackbody(f32),
     /// A spectrum times a factor: `Scaled(10, D65)`.
     Scaled(f32, Box<SpectrumDesc>),
+    /// `(nm, value)` pairs at any wavelengths in increasing order, linear between them and flat
+    /// beyond the ends, sampled at the 36 bin centres: `Table([(400, 0.1), (550, 0.8), (700, 0.3)])`.
+    Table(Vec<(f32, f32)>),
+    /// A two-column CSV file (`nm,value` per line, relative to the scene file; a header line,
+    /// blank lines and `#` comments are allowed), read like `Table`: `File("data/led.csv")`.
+    File(String),
+    /// Linear sRGB, uplifted to a smooth spectrum (Jakob and Hanika 2019): as a reflectance
+    /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
+    /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
+    Rgb(f32, f32, f32),
+    /// A spectrum scaled to the given luminance Y (a flat spectrum of 1 has Y = 1):
+    /// `Luminance(5, Blackbody(3000))` is a 3000 K emitter as bright as `Constant(5)`.
+    Luminance(f32, Box<SpectrumDesc>),
 }
 
 /// An index of refraction in the scene file.
@@ -290,7 +332,8 @@ pub struct ObjectDesc {
     /// The name of a material in `materials` (default: black, for lights).
     #[serde(default)]
     pub material: Option<String>,
-    /// Emitted radiance, making the object an area light (spheres and disks).
+    /// Emitted radiance, making the object an area light (spheres, disks,
+    /// quads, cuboids and meshes).
     #[serde(default)]
     pub emission: Option<SpectrumDesc>,
     /// Whether the emission leaves both sides of the surface (default false:
@@ -309,5 +352,36 @@ pub enum LightDesc {
         position: V3,
         /// Radiant intensity.
         intensity: SpectrumDesc,
+    },
+    /// A point light limited to a cone with a smooth falloff at its edge.
+    Spot {
+        /// Position.
+        position: V3,
+        /// The point the cone's axis goes through.
+        look_at: V3,
+        /// The cone's half-angle in degrees (0 to 90).
+        cone_deg: f32,
+        /// The width of the smooth edge inside the cone, in degrees (0 to `cone_deg`).
+        falloff_deg: f32,
+        /// Radiant intensity on the axis.
+        intensity: SpectrumDesc,
+    },
+    /// Parallel light from one direction everywhere (the sun).
+    Distant {
+        /// The direction the light travels in.
+        direction: V3,
+        /// Irradiance on a surface facing it.
+        irradiance: SpectrumDesc,
+    },
+    /// A collimated beam of parallel light from a disk.
+    Beam {
+        /// The centre of the emitting disk.
+        origin: V3,
+        /// The direction the light travels in (the disk faces it).
+        direction: V3,
+        /// The beam's radius.
+        radius: f32,
+        /// Irradiance across the beam.
+        irradiance: SpectrumDesc,
     },
 }

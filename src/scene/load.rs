@@ -2,6 +2,7 @@
 //! load meshes, and report mistakes with the file, line:column (from the RON
 //! parser) or the field path (for checks after parsing) and what was expected.
 
+use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -16,7 +17,8 @@ use crate::bxdf::{
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
-use crate::light::{DiskLight, Light, PointLight, SphereLight};
+use crate::io::{Fnv1a, fnv1a, parse_mesh, parse_spectrum_file, read_input};
+use crate::light::{AreaLight, BeamLight, DiskLight, DistantLight, Light, PointLight, SphereLight, SpotLight};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
 
@@ -26,43 +28,147 @@ use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Trans
 pub const MAX_MAGNITUDE: f32 = 1e15;
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
-/// precedence over the file's `render` settings.
+/// precedence over the file's `render` settings. The file must be a regular
+/// file of UTF-8 text (a byte-order mark is allowed).
 pub fn load_scene(path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    load_scene_str(&text, path, overrides)
+    let bytes = read_input(path)?;
+    let text = decode_text(&bytes, path)?;
+    load(text, &bytes, path, overrides)
 }
 
 /// Loads a scene from its text; `path` names it in errors and anchors
 /// relative mesh paths.
 pub fn load_scene_str(text: &str, path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
-    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-    let desc: SceneDesc = options.from_str(text).map_err(|e| Error::Scene {
-        path: path.to_path_buf(),
-        position: Some((e.span.start.line, e.span.start.col)),
-        field: String::new(),
-        message: e.code.to_string(),
-    })?;
-    let ctx = Ctx { path, dir: path.parent().map(Path::to_path_buf).unwrap_or_default() };
-    build(&ctx, desc, overrides, fnv1a(text.as_bytes()))
+    load(text, text.as_bytes(), path, overrides)
 }
 
-/// FNV-1a 64-bit hash, for recognising a scene's content in checkpoints.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    for &b in bytes {
-        h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+fn load(text: &str, bytes: &[u8], path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
+    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let desc: SceneDesc = options.from_str(text).map_err(|e| {
+        let message = e.code.to_string();
+        let message = match duplicate_key(&message).map(|name| key_positions(text, name)) {
+            Some(at) if at.len() >= 2 => {
+                format!("{message}: defined at {}:{} and again at {}:{}", at[0].0, at[0].1, at[1].0, at[1].1)
+            }
+            _ => message,
+        };
+        Error::Scene {
+            path: path.to_path_buf(),
+            position: Some((e.span.start.line, e.span.start.col)),
+            field: String::new(),
+            message,
+        }
+    })?;
+    let ctx = Ctx { path, dir: path.parent().map(Path::to_path_buf).unwrap_or_default(), inputs: RefCell::default() };
+    let mut scene = build(&ctx, desc, overrides)?;
+    let inputs = ctx.inputs.into_inner();
+    scene.content_hash = content_hash(bytes, &inputs);
+    scene.inputs = inputs.into_iter().map(|i| i.path).collect();
+    Ok(scene)
+}
+
+/// The scene's identity for checkpoints: the FNV-1a hash of its file, and
+/// when it reads other files (meshes, data), of those too, each by its name
+/// as written in the scene and its content's hash. A scene that reads no
+/// other file keeps the hash of its text alone, as checkpoints of format 1
+/// have always recorded it.
+fn content_hash(scene_bytes: &[u8], inputs: &[Input]) -> u64 {
+    if inputs.is_empty() {
+        return fnv1a(scene_bytes);
     }
-    h
+    let mut h = Fnv1a::default();
+    h.write(scene_bytes);
+    for i in inputs {
+        h.write(&[0xff]);
+        h.write(i.name.as_bytes());
+        h.write(&i.hash.to_le_bytes());
+    }
+    h.finish()
+}
+
+/// The scene text from the file's bytes: UTF-8, a leading byte-order mark
+/// skipped; UTF-16 or other bytes are an error at the first bad byte.
+fn decode_text<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str> {
+    let at = |offset: usize, message: String| {
+        let (line, col) = line_col(&bytes[..offset]);
+        Error::Scene { path: path.to_path_buf(), position: Some((line, col)), field: String::new(), message }
+    };
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return Err(at(0, "the file is UTF-16 (it starts with a UTF-16 byte-order mark); expected UTF-8 text".into()));
+    }
+    let body = bytes.strip_prefix(&[0xef, 0xbb, 0xbf]).unwrap_or(bytes);
+    let skipped = bytes.len() - body.len();
+    let text = std::str::from_utf8(body).map_err(|e| {
+        let offset = skipped + e.valid_up_to();
+        at(offset, format!("byte 0x{:02x} is not UTF-8; expected UTF-8 text", bytes[offset]))
+    })?;
+    if let Some(offset) = text.find('\0') {
+        return Err(at(skipped + offset, "a NUL byte (UTF-16 or binary data?); expected UTF-8 text".into()));
+    }
+    Ok(text)
+}
+
+/// 1-based line and column (in characters) just after `before`.
+fn line_col(before: &[u8]) -> (usize, usize) {
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let last = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let col = String::from_utf8_lossy(&before[last..]).chars().count() + 1;
+    (line, col)
+}
+
+/// The name in a duplicate-key error of [`super::desc`].
+fn duplicate_key(message: &str) -> Option<&str> {
+    message.strip_prefix("duplicate material \"")?.split('"').next()
+}
+
+/// Where `"name"` stands as a map key (followed by `:`) in the text.
+fn key_positions(text: &str, name: &str) -> Vec<(usize, usize)> {
+    let quoted = format!("\"{name}\"");
+    text.match_indices(&quoted)
+        .filter(|(i, _)| text[i + quoted.len()..].trim_start().starts_with(':'))
+        .map(|(i, _)| line_col(&text.as_bytes()[..i]))
+        .collect()
+}
+
+/// A file the scene reads besides itself.
+struct Input {
+    /// The path as written in the scene.
+    name: String,
+    /// The path it resolves to.
+    path: PathBuf,
+    /// FNV-1a of its content.
+    hash: u64,
+}
+
+/// What a spectrum describes: it decides what `Rgb(r, g, b)` means.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// A reflectance: the uplifted colour itself, within [0, 1].
+    Reflectance,
+    /// An emission or intensity: the uplifted colour times D65.
+    Emission,
 }
 
 struct Ctx<'a> {
     path: &'a Path,
     dir: PathBuf,
+    /// Every file read so far, in order (for the scene's identity).
+    inputs: RefCell<Vec<Input>>,
 }
 
 impl Ctx<'_> {
     fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
         Error::scene_field(self.path, field, message)
+    }
+
+    /// Reads a file the scene names (`rel`, relative to the scene file) for
+    /// field `field`, and records it in the scene's identity. Only regular
+    /// files are read.
+    fn read_input(&self, field: &str, rel: &str) -> Result<(PathBuf, Vec<u8>)> {
+        let path = self.dir.join(rel);
+        let bytes = read_input(&path).map_err(|e| self.err(field, e.to_string()))?;
+        self.inputs.borrow_mut().push(Input { name: rel.to_string(), path: path.clone(), hash: fnv1a(&bytes) });
+        Ok((path, bytes))
     }
 
     fn positive(&self, field: &str, v: f32) -> Result<f32> {
@@ -87,7 +193,46 @@ impl Ctx<'_> {
         v.try_normalize().ok_or_else(|| self.err(field, "expected a non-zero direction"))
     }
 
+    /// A text file the scene refers to (a spectrum table), read through
+    /// [`Ctx::read_input`] like every input: the resolved path and the text.
+    fn read_text_input(&self, field: &str, rel: &str) -> Result<(PathBuf, String)> {
+        let (path, bytes) = self.read_input(field, rel)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            self.err(field, format!("\"{}\": byte {at} is not UTF-8; expected a UTF-8 text file", path.display()))
+        })?;
+        Ok((path, text))
+    }
+
+    /// Checks a table's points (finite, wavelengths strictly increasing, at least one).
+    fn table(&self, field: &str, points: &[(f32, f32)]) -> Result<Spectrum> {
+        if points.is_empty() {
+            return Err(self.err(field, "expected at least one (nm, value) pair"));
+        }
+        for (k, w) in points.iter().enumerate() {
+            if !(w.0.is_finite() && w.1.is_finite() && w.0 > 0.0) {
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("expected a positive wavelength in nm and a finite value, found {w:?}"),
+                ));
+            }
+            if k > 0 && w.0 <= points[k - 1].0 {
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("wavelengths must increase: {} nm follows {} nm", w.0, points[k - 1].0),
+                ));
+            }
+        }
+        Ok(Spectrum::from_table(points))
+    }
+
+    /// A spectrum for emission or intensity (any non-negative values).
     fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+        self.spectrum_as(field, s, Role::Emission)
+    }
+
+    /// A spectrum in a role; the role decides what `Rgb` means.
+    fn spectrum_as(&self, field: &str, s: &SpectrumDesc, role: Role) -> Result<Spectrum> {
         let out = match s {
             SpectrumDesc::Constant(v) => Spectrum::splat(*v),
             SpectrumDesc::Samples(v) => {
@@ -111,7 +256,47 @@ impl Ctx<'_> {
             SpectrumDesc::EqualEnergy => color::equal_energy(),
             SpectrumDesc::Blackbody(t) => color::blackbody(*t)
                 .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
-            SpectrumDesc::Scaled(k, inner) => self.spectrum(field, inner)? * *k,
+            SpectrumDesc::Scaled(k, inner) => self.spectrum_as(field, inner, role)? * *k,
+            SpectrumDesc::Table(points) => self.table(field, points)?,
+            SpectrumDesc::File(rel) => {
+                let (path, text) = self.read_text_input(field, rel)?;
+                let points = parse_spectrum_file(&text).map_err(|e| Error::Scene {
+                    path: path.clone(),
+                    position: Some((e.line, e.col)),
+                    field: field.to_string(),
+                    message: e.message,
+                })?;
+                self.table(field, &points).map_err(|e| match e {
+                    Error::Scene { field, message, .. } => {
+                        Error::Scene { path: path.clone(), position: None, field, message }
+                    }
+                    e => e,
+                })?
+            }
+            SpectrumDesc::Rgb(r, g, b) => {
+                let rgb = [*r, *g, *b];
+                let limit = if role == Role::Reflectance { 1.0 } else { MAX_MAGNITUDE };
+                if !rgb.iter().all(|v| v.is_finite() && (0.0..=limit).contains(v)) {
+                    return Err(
+                        self.err(field, format!("expected linear sRGB components in [0, {limit}], found {rgb:?}"))
+                    );
+                }
+                match role {
+                    Role::Reflectance => color::rgb_reflectance(rgb),
+                    Role::Emission => color::rgb_emission(rgb),
+                }
+            }
+            SpectrumDesc::Luminance(y, inner) => {
+                let s = self.spectrum_as(field, inner, role)?;
+                let have = s.to_xyz().y;
+                if !(y.is_finite() && *y >= 0.0 && *y <= MAX_MAGNITUDE) {
+                    return Err(self.err(field, format!("expected a luminance in [0, {MAX_MAGNITUDE:e}], found {y}")));
+                }
+                if !(have > 0.0 && have.is_finite()) {
+                    return Err(self.err(field, format!("cannot scale a spectrum of luminance {have} to {y}")));
+                }
+                s * (*y / have)
+            }
         };
         if out.has_nan_or_inf() || out.min_value() < 0.0 || out.max_value() > MAX_MAGNITUDE {
             return Err(self.err(field, format!("expected finite, non-negative values up to {MAX_MAGNITUDE:e}")));
@@ -120,7 +305,7 @@ impl Ctx<'_> {
     }
 
     fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
-        let r = self.spectrum(field, s)?;
+        let r = self.spectrum_as(field, s, Role::Reflectance)?;
         if r.max_value() > 1.0 {
             return Err(self.err(field, format!("a reflectance must lie in [0, 1], found {}", r.max_value())));
         }
@@ -313,24 +498,34 @@ impl Ctx<'_> {
                 };
                 let transform = Transform {
                     scale,
-                    rotate_deg: rotate_deg.map(Vec3::from).unwrap_or(Vec3::ZERO),
-                    translate: translate.map(Vec3::from).unwrap_or(Vec3::ZERO),
+                    rotate_deg: match rotate_deg {
+                        Some(r) => self.vec(&f("rotate_deg"), *r)?,
+                        None => Vec3::ZERO,
+                    },
+                    translate: match translate {
+                        Some(t) => self.vec(&f("translate"), *t)?,
+                        None => Vec3::ZERO,
+                    },
                 };
-                let file = self.dir.join(path);
-                let mesh = Mesh::load(&file, &transform).map_err(|e| self.err(f("path"), e.to_string()))?;
+                let (file, bytes) = self.read_input(&f("path"), path)?;
+                let data = parse_mesh(bytes, &file).map_err(|e| self.err(f("path"), e.to_string()))?;
+                let mesh = Mesh::from_data(data, &file, &transform).map_err(|e| match e {
+                    Error::Setting { name, message } => self.err(f(name), message),
+                    e => self.err(f("path"), e.to_string()),
+                })?;
                 Shape::Mesh(Box::new(mesh))
             }
         })
     }
 }
 
-fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash: u64) -> Result<Scene> {
+fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Scene> {
     let settings = settings(ctx, &desc.render, overrides)?;
 
     // Materials by name; index 0 is the implicit black material of lights.
     let mut materials = vec![Bxdf::Black];
     let mut by_name = BTreeMap::new();
-    for (name, m) in &desc.materials {
+    for (name, m) in &desc.materials.0 {
         by_name.insert(name.as_str(), materials.len() as u32);
         materials.push(ctx.material(&format!("materials.\"{name}\""), m)?);
     }
@@ -355,10 +550,23 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
             None => None,
             Some(e) => {
                 let radiance = ctx.spectrum(&format!("{field}.emission"), e)?;
+                let two = o.two_sided;
+                let flat = |l: Option<AreaLight>| {
+                    l.map(Light::Area)
+                        .ok_or_else(|| ctx.err(format!("{field}.shape"), "an emitter needs a non-zero area"))
+                };
                 let l = match &shape {
-                    Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided: o.two_sided }),
-                    Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided: o.two_sided }),
-                    _ => return Err(ctx.err(format!("{field}.emission"), "only Sphere and Disk shapes can emit")),
+                    Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided: two }),
+                    Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided: two }),
+                    Shape::Quad(q) => flat(AreaLight::quad(q, radiance, two))?,
+                    Shape::Cuboid(c) => flat(AreaLight::cuboid(c, radiance, two))?,
+                    Shape::Mesh(m) => flat(AreaLight::mesh(m, radiance, two))?,
+                    Shape::Plane(_) | Shape::Bubble(_) => {
+                        return Err(ctx.err(
+                            format!("{field}.emission"),
+                            "a Plane (infinite) or Bubble cannot emit; expected a Sphere, Disk, Quad, Cuboid or Mesh",
+                        ));
+                    }
                 };
                 lights.push(l);
                 Some(lights.len() as u32 - 1)
@@ -371,6 +579,36 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
             LightDesc::Point { position, intensity } => lights.push(Light::Point(PointLight {
                 position: ctx.vec(&format!("lights[{i}].position"), *position)?,
                 intensity: ctx.spectrum(&format!("lights[{i}].intensity"), intensity)?,
+            })),
+            LightDesc::Spot { position, look_at, cone_deg, falloff_deg, intensity } => {
+                let f = |name: &str| format!("lights[{i}].{name}");
+                let position = ctx.vec(&f("position"), *position)?;
+                let target = ctx.vec(&f("look_at"), *look_at)?;
+                let axis = (target - position)
+                    .try_normalize()
+                    .ok_or_else(|| ctx.err(f("look_at"), "must differ from position"))?;
+                if !(cone_deg.is_finite() && *cone_deg > 0.0 && *cone_deg <= 90.0) {
+                    return Err(ctx.err(f("cone_deg"), format!("expected degrees in (0, 90], found {cone_deg}")));
+                }
+                if !(falloff_deg.is_finite() && (0.0..=*cone_deg).contains(falloff_deg)) {
+                    return Err(ctx.err(
+                        f("falloff_deg"),
+                        format!("expected degrees from 0 to cone_deg ({cone_deg}), found {falloff_deg}"),
+                    ));
+                }
+                let intensity = ctx.spectrum(&f("intensity"), intensity)?;
+                lights.push(Light::Spot(SpotLight::new(position, axis, *cone_deg, *falloff_deg, intensity)));
+            }
+            LightDesc::Distant { direction, irradiance } => lights.push(Light::Distant(DistantLight {
+                direction: ctx.direction(&format!("lights[{i}].direction"), *direction)?,
+                irradiance: ctx.spectrum(&format!("lights[{i}].irradiance"), irradiance)?,
+                scene_radius: 1.0,
+            })),
+            LightDesc::Beam { origin, direction, radius, irradiance } => lights.push(Light::Beam(BeamLight {
+                origin: ctx.vec(&format!("lights[{i}].origin"), *origin)?,
+                direction: ctx.direction(&format!("lights[{i}].direction"), *direction)?,
+                radius: ctx.positive(&format!("lights[{i}].radius"), *radius)?,
+                irradiance: ctx.spectrum(&format!("lights[{i}].irradiance"), irradiance)?,
             })),
         }
     }
@@ -391,12 +629,14 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch, content_hash
         return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {}", c.fov_deg)));
     }
     let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height);
-    Ok(Scene::new(objects, materials, lights, camera, settings, content_hash))
+    Ok(Scene::new(objects, materials, lights, camera, settings, 0))
 }
 
 /// Combines defaults, the file's `render` block and the command line, and checks the result.
 fn settings(ctx: &Ctx<'_>, file: &SettingsPatch, cli: &SettingsPatch) -> Result<Settings> {
     let s = Settings::combine(file, cli);
-    s.check().map_err(|(field, message)| ctx.err(format!("render.{field}"), message))?;
+    if let Err(Error::Setting { name, message }) = s.check() {
+        return Err(ctx.err(format!("render.{name}"), message));
+    }
     Ok(s)
 }

@@ -14,7 +14,7 @@ pub use load::{load_scene, load_scene_str};
 
 use crate::bxdf::Bxdf;
 use crate::camera::Camera;
-use crate::geometry::{Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray};
 use crate::light::Light;
 use crate::settings::Settings;
 use crate::shape::Bvh;
@@ -68,8 +68,12 @@ pub struct Scene {
     /// Indices of unbounded objects (planes).
     unbounded: Vec<u32>,
     bvh: Option<Bvh>,
-    /// A hash of the scene file's content (for checkpoints).
+    /// The identity of the scene file and every file it reads (for
+    /// checkpoints: resume and merge refuse other inputs).
     pub content_hash: u64,
+    /// Every file the scene reads besides itself (meshes, data files), as
+    /// resolved paths: no output may overwrite one.
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 impl Scene {
@@ -78,7 +82,7 @@ impl Scene {
     pub fn new(
         objects: Vec<Object>,
         materials: Vec<Bxdf>,
-        lights: Vec<Light>,
+        mut lights: Vec<Light>,
         camera: Camera,
         settings: Settings,
         content_hash: u64,
@@ -94,6 +98,12 @@ impl Scene {
                 }
                 None => unbounded.push(i as u32),
             }
+        }
+        // A sphere around everything bounded and the camera, for distant lights.
+        let world = bounds.iter().fold(Aabb::new(camera.eye(), camera.eye()), |a, b| a.union(b));
+        let radius = (world.diagonal().length() * 0.5).max(1.0);
+        for l in &mut lights {
+            l.set_scene_radius(radius);
         }
         let bvh = (bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);
@@ -127,6 +137,7 @@ impl Scene {
             unbounded,
             bvh,
             content_hash,
+            inputs: Vec::new(),
         }
     }
 

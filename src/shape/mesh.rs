@@ -73,10 +73,17 @@ impl Mesh {
     /// Loads a mesh from `.obj` (tobj, triangulated) or `.ply` (ASCII or binary), either
     /// optionally gzip-compressed (`.obj.gz`, `.ply.gz`), and applies `transform`.
     /// Zero-area triangles are dropped and counted ([`Mesh::degenerate_dropped`]); a mesh
-    /// with no valid triangle, an out-of-range index, a non-finite coordinate or a
-    /// singular transform is an error naming the file.
+    /// with no valid triangle, an out-of-range index or a non-finite coordinate is an
+    /// error naming the file; a transform that is singular or sends a vertex out of
+    /// f32's range is an [`Error::Setting`] naming the transform's field (`scale`,
+    /// `rotate_deg`, `translate`).
     pub fn load(path: &Path, transform: &Transform) -> Result<Mesh> {
-        let MeshData { positions, triangles, normals } = read_mesh_file(path)?;
+        Mesh::from_data(read_mesh_file(path)?, path, transform)
+    }
+
+    /// [`Mesh::load`] from a mesh file's parsed contents (`path` names it in errors).
+    pub fn from_data(data: MeshData, path: &Path, transform: &Transform) -> Result<Mesh> {
+        let MeshData { positions, triangles, normals } = data;
         Mesh::build(positions, triangles, normals, transform, &|m| Error::mesh(path, m))
     }
 
@@ -102,10 +109,23 @@ impl Mesh {
         transform: &Transform,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
+        let setting = |name, message| Error::Setting { name, message };
+        if !transform.rotate_deg.is_finite() {
+            return Err(setting("rotate_deg", format!("expected finite angles, found {}", transform.rotate_deg)));
+        }
+        if !transform.translate.is_finite() {
+            return Err(setting("translate", format!("expected finite coordinates, found {}", transform.translate)));
+        }
         let m = transform.linear();
         let det = m.determinant();
-        if !(det != 0.0 && det.is_finite() && transform.translate.is_finite()) {
-            return Err(err(format!("transform {transform:?} is singular or not finite")));
+        if !(det != 0.0 && det.is_finite()) {
+            return Err(setting(
+                "scale",
+                format!(
+                    "the scale {} makes the transform singular in f32 (its determinant is {det:e})",
+                    transform.scale
+                ),
+            ));
         }
         if let Some(ns) = &normals
             && ns.len() != positions.len()
@@ -114,9 +134,15 @@ impl Mesh {
         }
         for (i, p) in positions.iter_mut().enumerate() {
             if !p.is_finite() {
-                return Err(err(format!("vertex {i} has a non-finite coordinate {p:?}")));
+                return Err(err(format!("vertex {i} has a non-finite coordinate {p}")));
             }
             *p = m * *p + transform.translate;
+            if !p.is_finite() {
+                return Err(setting(
+                    "scale",
+                    format!("vertex {i} leaves f32's range after the transform: the scale or translation is too large"),
+                ));
+            }
         }
         if let Some(ns) = normals.as_mut() {
             let nm = m.inverse().transpose();

@@ -31,7 +31,7 @@ fn absorbing_slab_matches_the_closed_form() {
     );
     let f = 0.04f64;
     let t = |s: f64| (1.0 - f).powi(2) * (-s).exp() / (1.0 - f * f * (-2.0 * s).exp());
-    let cmf = rust_v::color::CMF_NORMALISED;
+    let cmf = rust_v::color::color_weights();
     let want: f64 = (0..36).map(|b| t(sigma[b]) * cmf[b][1] as f64).sum();
     for m in METHODS {
         let film = render_str(&scene, &method(m, 64, 21));

@@ -1,0 +1,42 @@
+//! A distant light (the sun): irradiance `E(λ)` on a surface facing it,
+//! from one direction, everywhere in the scene. A delta light in direction:
+//! a shading point sees it through a shadow ray towards `-direction`, long
+//! enough to leave the scene's bounds.
+//!
+//! ```ron
+//! lights: [ Distant(direction: (-1, -2, -1), irradiance: Scaled(3, D65)) ],
+//! ```
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::LightSample;
+use crate::color::Spectrum;
+
+/// Parallel light travelling along `direction`.
+#[derive(Clone, Debug)]
+pub struct DistantLight {
+    /// Unit direction the light travels in.
+    pub direction: Vec3,
+    /// Irradiance per wavelength on a surface perpendicular to it.
+    pub irradiance: Spectrum,
+    /// Radius of a sphere around the scene's bounded objects and camera
+    /// (set by the scene): shadow rays are this long, twice over.
+    pub scene_radius: f32,
+}
+
+impl DistantLight {
+    /// Total power up to the spectrum's shape: the irradiance through the
+    /// scene's disk, `π R² E`.
+    pub fn power(&self) -> f32 {
+        PI * self.scene_radius * self.scene_radius * self.irradiance.average()
+    }
+
+    /// The direction to the light from any point, and a point far outside the scene along it.
+    #[inline]
+    pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
+        let wi = -self.direction;
+        let point = p + wi * (2.0 * self.scene_radius);
+        Some(LightSample { wi, point, pdf: 1.0, scale: 1.0, is_delta: true })
+    }
+}

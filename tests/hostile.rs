@@ -1,0 +1,466 @@
+//! The command line under hostile conditions (issue: never lose a render,
+//! never overwrite what is not ours). A test per class: outputs checked up
+//! front and work kept when the end fails, no file aliasing, closed or full
+//! output streams, blocking inputs, every flag value, scene text encodings,
+//! field paths in errors, consistent limits, warnings under `--quiet`, and
+//! resume knowing every input. Renders are 8x8 to 16x16.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::common::{root, temp_dir, wait_for};
+
+/// A tiny scene: a diffuse sphere lit by a point light.
+const SCENE: &str = r#"(
+    camera: (eye: (0, 0, 4), look_at: (0, 0, 0), fov_deg: 30),
+    render: (width: 8, height: 8, spp: 2),
+    materials: { "white": Lambertian(reflectance: Constant(0.5)) },
+    objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "white") ],
+    lights: [ Point(position: (0, 3, 3), intensity: Constant(10)) ],
+)"#;
+
+/// The same with a mesh (`tri.obj` beside it).
+const MESH_SCENE: &str = r#"(
+    camera: (eye: (0, 0, 4), look_at: (0, 0, 0), fov_deg: 30),
+    render: (width: 8, height: 8, spp: 2),
+    materials: { "white": Lambertian(reflectance: Constant(0.5)) },
+    objects: [ (shape: Mesh(path: "tri.obj"), material: "white") ],
+    lights: [ Point(position: (0, 3, 3), intensity: Constant(10)) ],
+)"#;
+
+const TRI_OBJ: &str = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n";
+
+fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_rust-v"));
+    c.current_dir(root());
+    c
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().expect("binary runs")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The one error line of a failed run, after checking the exit status and
+/// that no panic or backtrace was printed.
+fn one_error(o: &Output, status: i32) -> String {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(status), "exit status; stderr:\n{err}");
+    assert!(!err.contains("panicked") && !err.contains("backtrace"), "a panic:\n{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("rust-v: error:")).collect();
+    assert_eq!(lines.len(), 1, "expected one error line:\n{err}");
+    assert!(!err.lines().any(|l| !l.starts_with("rust-v: ")), "a line not in rust-v's style:\n{err}");
+    lines[0].to_string()
+}
+
+fn scene_in(dir: &Path, text: &str) -> PathBuf {
+    let p = dir.join("scene.ron");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+// ---------------------------------------------------------------------------
+// 1. Outputs checked up front; work kept when the end fails.
+
+#[test]
+fn unwritable_outputs_are_refused_before_rendering() {
+    let d = temp_dir("hostile-outputs");
+    let scene = scene_in(&d, SCENE);
+    // /proc takes no new files, even for root; a missing directory; a name over NAME_MAX.
+    let long = d.join("x".repeat(252) + ".png");
+    let missing = d.join("no/such/dir/out.png");
+    for out in [Path::new("/proc/rust-v-out.png"), &missing, &long] {
+        let o = run(&["render", s(&scene), "-o", s(out)]);
+        let e = one_error(&o, 1);
+        assert!(e.contains("image"), "{e}");
+        assert!(!stderr(&o).contains("wrote"), "rendered before failing:\n{}", stderr(&o));
+    }
+    // A legal name just under the limit works: its temporary name is shortened.
+    let legal = d.join("y".repeat(NAME_OK) + ".png");
+    let o = run(&["render", s(&scene), "-q", "-o", s(&legal), "--checkpoint", s(&d.join("c.ckpt"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(legal.exists());
+    // A checkpoint path that is a device or a directory.
+    for ck in [Path::new("/dev/null"), d.as_path()] {
+        let o = run(&["render", s(&scene), "-o", s(&d.join("a.png")), "--checkpoint", s(ck)]);
+        assert!(one_error(&o, 1).contains("checkpoint"));
+    }
+}
+
+/// 255 bytes in all with ".png", less what snapshot names add (`-NNNNNNNNNN`).
+const NAME_OK: usize = 255 - 4 - 11;
+
+#[test]
+fn a_failing_final_write_keeps_the_passes_in_the_checkpoint() {
+    let d = temp_dir("hostile-final");
+    let scene = scene_in(&d, SCENE);
+    let out_dir = d.join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    let ckpt = d.join("keep.ckpt");
+    // Render for 1.5 s; remove the image's directory while it runs.
+    let child = bin()
+        .args(["render", s(&scene), "-o", s(&out_dir.join("img.png")), "--checkpoint", s(&ckpt), "--time", "1.5"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(400));
+    std::fs::remove_dir_all(&out_dir).unwrap();
+    let o = child.wait_with_output().unwrap();
+    let e = one_error(&o, 1);
+    assert!(e.contains("img.png") && e.contains("keep.ckpt") && e.contains("rust-v resume"), "{e}");
+    // The checkpoint holds the passes and resumes to an image elsewhere.
+    let other = d.join("other.png");
+    let o = run(&["resume", s(&ckpt), "-q", "--spp", "1", "-o", s(&other)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(other.exists());
+}
+
+// ---------------------------------------------------------------------------
+// 2. No file aliasing.
+
+#[test]
+fn no_output_may_be_an_input_or_another_output() {
+    let d = temp_dir("hostile-alias");
+    let scene = scene_in(&d, MESH_SCENE);
+    let mesh = d.join("tri.obj");
+    std::fs::write(&mesh, TRI_OBJ).unwrap();
+    std::fs::hard_link(&scene, d.join("hard.ckpt")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&mesh, d.join("soft.ckpt")).unwrap();
+    let before = (std::fs::read(&scene).unwrap(), std::fs::read(&mesh).unwrap());
+    let png = d.join("a.png");
+    let cases: Vec<Vec<String>> = vec![
+        vec!["--checkpoint".into(), s(&scene).into()],
+        vec!["--checkpoint".into(), s(&d.join("hard.ckpt")).into()],
+        vec!["--checkpoint".into(), s(&d.join("soft.ckpt")).into()],
+        vec!["--checkpoint".into(), s(&d.join("sub/../scene.ron")).into()],
+        vec!["--checkpoint".into(), s(&png).into()],
+        vec!["--checkpoint".into(), s(&d.join("a-00002.png")).into()],
+    ];
+    std::fs::create_dir(d.join("sub")).unwrap();
+    for extra in cases {
+        let mut args = vec!["render", s(&scene), "-o", s(&png)];
+        args.extend(extra.iter().map(String::as_str));
+        let o = run(&args);
+        let e = one_error(&o, 1);
+        assert!(e.contains("refusing") || e.contains("same file") || e.contains("snapshot"), "{extra:?}: {e}");
+    }
+    // The image itself may not overwrite the mesh (renamed to .png through a link).
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&mesh, d.join("mesh.png")).unwrap();
+        let o = run(&["render", s(&scene), "-o", s(&d.join("mesh.png"))]);
+        assert!(one_error(&o, 1).contains("refusing to overwrite an input"));
+    }
+    assert_eq!((std::fs::read(&scene).unwrap(), std::fs::read(&mesh).unwrap()), before, "an input changed");
+    // merge: the output may not be one of its parts.
+    let part = d.join("p.ckpt");
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("p.png")), "--checkpoint", s(&part)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["merge", s(&part), "-o", s(&part)]);
+    assert!(one_error(&o, 1).contains("refusing to overwrite an input"));
+}
+
+// ---------------------------------------------------------------------------
+// 3. Closed or full output streams.
+
+#[test]
+fn a_closed_or_full_stderr_never_loses_the_image() {
+    let d = temp_dir("hostile-streams");
+    let scene = scene_in(&d, SCENE);
+    // stderr a pipe whose reader is gone before the first line.
+    let out = d.join("closed.png");
+    let mut child = bin()
+        .args(["render", s(&scene), "-o", s(&out), "--spp", "64"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert!(status.success(), "exit {status:?} with a closed stderr");
+    assert!(out.exists(), "no image with a closed stderr");
+    // stderr on a full device.
+    let out = d.join("full.png");
+    let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+    let status = bin().args(["render", s(&scene), "-o", s(&out)]).stderr(full).status().unwrap();
+    assert!(status.success() && out.exists(), "exit {status:?} with stderr on /dev/full");
+    // compare --json into a closed stdout: a clean failure, no panic.
+    let mut child = bin()
+        .args(["compare", s(&out), s(&out), "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let mut err = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(status.success() || err.contains("standard output"), "{status:?}: {err}");
+}
+
+#[test]
+fn without_a_terminal_progress_is_at_most_an_occasional_plain_line() {
+    let d = temp_dir("hostile-progress");
+    let scene = scene_in(&d, SCENE);
+    let o = run(&["render", s(&scene), "-o", s(&d.join("p.png")), "--spp", "64"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(!err.contains('\r') && !err.contains('\x1b'), "terminal drawing without a terminal: {err:?}");
+    assert!(err.lines().count() <= 4, "{err}");
+}
+
+// ---------------------------------------------------------------------------
+// 4. Blocking inputs.
+
+#[test]
+fn fifos_devices_and_directories_are_refused_as_inputs() {
+    let d = temp_dir("hostile-fifo");
+    let fifo = d.join("scene.ron");
+    let made = Command::new("mkfifo").arg(&fifo).status().map(|s| s.success()).unwrap_or(false);
+    let mut inputs: Vec<PathBuf> = vec![d.clone(), PathBuf::from("/dev/zero")];
+    if made {
+        inputs.push(fifo.clone());
+    } else {
+        println!("skipping the FIFO case: mkfifo is not available");
+    }
+    for p in &inputs {
+        let t = Instant::now();
+        let o = run(&["render", s(p)]);
+        let e = one_error(&o, 1);
+        assert!(e.contains("expected a regular file"), "{}: {e}", p.display());
+        assert!(t.elapsed() < Duration::from_secs(20), "{} blocked", p.display());
+    }
+    // A mesh that is a FIFO or a directory.
+    if made {
+        let scene = d.join("m.ron");
+        std::fs::write(&scene, MESH_SCENE.replace("tri.obj", "scene.ron")).unwrap();
+        let e = one_error(&run(&["render", s(&scene)]), 1);
+        assert!(e.contains("objects[0].shape.path") && e.contains("FIFO"), "{e}");
+    }
+}
+
+#[test]
+fn sigint_ends_a_render_promptly_and_saves_it() {
+    let d = temp_dir("hostile-sigint");
+    let scene = scene_in(&d, SCENE);
+    let ckpt = d.join("s.ckpt");
+    let child = bin()
+        .args(["render", s(&scene), "-o", s(&d.join("s.png")), "--checkpoint", s(&ckpt), "--time", "60"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id().to_string();
+    std::thread::sleep(Duration::from_millis(300));
+    let t = Instant::now();
+    Command::new("kill").args(["-INT", &pid]).status().unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(t.elapsed() < Duration::from_secs(5), "took {:?} to stop", t.elapsed());
+    assert!(wait_for(Duration::from_secs(1), || ckpt.exists()), "no checkpoint after SIGINT");
+}
+
+// ---------------------------------------------------------------------------
+// 5. Every flag value.
+
+#[test]
+fn every_bad_flag_value_is_one_usage_error() {
+    let scene = "scenes/cornell.ron";
+    let bad: &[&[&str]] = &[
+        &["--time", "1e300"],
+        &["--time", "nan"],
+        &["--time", "0"],
+        &["--time", "-1"],
+        &["--time", "inf"],
+        &["--checkpoint-every", "1e20"],
+        &["--checkpoint-every", "NaN"],
+        &["--threads", "0"],
+        &["--threads", "99999"],
+        &["--spp", "0"],
+        &["--spp", "4294967296"],
+        &["--width", "0"],
+        &["--width", "40000"],
+        &["--height", "-3"],
+        &["--seed", "18446744073709551616"],
+        &["--max-bounces", "x"],
+        &["--packet-size", "3"],
+        &["--integrator", "bdpt2"],
+        &["--wavelengths", "HERO"],
+        &["--passes", "5..5"],
+        &["--passes", "9..2"],
+        &["--passes", "a..b"],
+        &["--passes", "0..4294967296"],
+        &["--bogus"],
+    ];
+    for extra in bad {
+        let mut args = vec!["render", scene];
+        args.extend_from_slice(extra);
+        let e = one_error(&run(&args), 2);
+        assert!(e.len() < 300, "{extra:?}: {e}");
+    }
+    assert!(one_error(&run(&["render"]), 2).contains("<SCENE>"));
+    assert!(one_error(&run(&["resume", "x.ckpt", "--spp", "0"]), 2).contains("--spp"));
+    assert!(one_error(&run(&["converge", scene, "--reference", "r.exr", "--seeds", "0"]), 2).contains("--seeds"));
+    assert!(one_error(&run(&["frobnicate"]), 2).contains("frobnicate"));
+}
+
+// ---------------------------------------------------------------------------
+// 6. Scene text.
+
+#[test]
+fn scene_text_encodings_and_duplicate_materials() {
+    let d = temp_dir("hostile-text");
+    let bom = d.join("bom.ron");
+    std::fs::write(&bom, [&[0xef, 0xbb, 0xbf][..], SCENE.as_bytes()].concat()).unwrap();
+    let o = run(&["render", s(&bom), "-q", "-o", s(&d.join("bom.png"))]);
+    assert!(o.status.success(), "a UTF-8 BOM is accepted: {}", stderr(&o));
+    let utf16: Vec<u8> = [0xff, 0xfe].into_iter().chain(SCENE.encode_utf16().flat_map(|u| u.to_le_bytes())).collect();
+    let p = d.join("u16.ron");
+    std::fs::write(&p, utf16).unwrap();
+    let e = one_error(&run(&["render", s(&p)]), 1);
+    assert!(e.contains("u16.ron:1:1") && e.contains("UTF-16"), "{e}");
+    // UTF-16 without a byte-order mark: a NUL byte at line 1, column 2.
+    let bare: Vec<u8> = SCENE.encode_utf16().flat_map(|u| u.to_le_bytes()).collect();
+    std::fs::write(&p, bare).unwrap();
+    let e = one_error(&run(&["render", s(&p)]), 1);
+    assert!(e.contains("u16.ron:1:2") && e.contains("NUL"), "{e}");
+    // A bad byte on line 3, column 5.
+    let mut bytes = SCENE.as_bytes().to_vec();
+    let line3 = SCENE.match_indices('\n').nth(1).unwrap().0 + 1;
+    bytes[line3 + 4] = 0xff;
+    let p = d.join("bad.ron");
+    std::fs::write(&p, bytes).unwrap();
+    let e = one_error(&run(&["render", s(&p)]), 1);
+    assert!(e.contains("bad.ron:3:5") && e.contains("0xff"), "{e}");
+    // The same material twice: both places named.
+    let dup = SCENE.replace(
+        r#""white": Lambertian(reflectance: Constant(0.5)) },"#,
+        "\"white\": Lambertian(reflectance: Constant(0.5)),\n        \"white\": Black },",
+    );
+    let p = d.join("dup.ron");
+    std::fs::write(&p, dup).unwrap();
+    let e = one_error(&run(&["render", s(&p)]), 1);
+    assert!(e.contains("duplicate material \"white\"") && e.contains("at 4:18") && e.contains("again at 5:9"), "{e}");
+}
+
+// ---------------------------------------------------------------------------
+// 7. Errors name the field.
+
+#[test]
+fn mesh_transform_errors_name_the_field() {
+    let d = temp_dir("hostile-transform");
+    std::fs::write(d.join("tri.obj"), TRI_OBJ).unwrap();
+    std::fs::write(d.join("big.obj"), "v 1e30 0 0\nv 0 1e30 0\nv 0 0 1\nf 1 2 3\n").unwrap();
+    let cases = [
+        ("tri.obj", "scale: 1e-30", "objects[0].shape.scale"),
+        ("tri.obj", "scale: (1e-30, 1e-30, 1)", "objects[0].shape.scale"),
+        ("big.obj", "scale: 1e15", "objects[0].shape.scale"),
+        ("tri.obj", "translate: (1e30, 0, 0)", "objects[0].shape.translate"),
+        ("tri.obj", "rotate_deg: (NaN, 0, 0)", "objects[0].shape.rotate_deg"),
+        ("tri.obj", "rotate_deg: (0, inf, 0)", "objects[0].shape.rotate_deg"),
+        ("tri.obj", "scale: -2", "objects[0].shape.scale"),
+    ];
+    for (mesh, fields, want) in cases {
+        let p = d.join("t.ron");
+        let shape = format!(r#"Mesh(path: "{mesh}", {fields})"#);
+        std::fs::write(&p, MESH_SCENE.replace(r#"Mesh(path: "tri.obj")"#, &shape)).unwrap();
+        let e = one_error(&run(&["render", s(&p), "-o", s(&d.join("t.png"))]), 1);
+        assert!(e.contains(want), "{fields}: {e}");
+        assert!(!e.contains("Transform {") && !e.contains("Vec3("), "{fields}: a Debug dump: {e}");
+    }
+}
+
+// ---------------------------------------------------------------------------
+// 8. Consistent limits.
+
+#[test]
+fn an_image_too_large_for_memory_is_refused_before_allocating() {
+    let o = run(&["render", "scenes/cornell.ron", "--width", "32768", "--height", "32768", "-o", "/tmp/never.png"]);
+    let e = one_error(&o, 1);
+    assert!(e.contains("GB of memory"), "{e}");
+}
+
+#[test]
+fn emission_beyond_the_film_range_is_warned_before_rendering() {
+    let d = temp_dir("hostile-bright");
+    let scene = scene_in(&d, &SCENE.replace("intensity: Constant(10)", "intensity: Constant(1e12)"));
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("b.png"))]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let first = err.lines().next().unwrap_or_default();
+    assert!(first.starts_with("rust-v: warning: light 0 emits up to 1e12"), "{err}");
+}
+
+// ---------------------------------------------------------------------------
+// 9. Warnings are not progress.
+
+#[test]
+fn quiet_keeps_warnings() {
+    let d = temp_dir("hostile-quiet");
+    let scene = scene_in(&d, SCENE);
+    let ckpt = d.join("q.ckpt");
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("q.png")), "--checkpoint", s(&ckpt), "--passes", "0..1"]);
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
+    // Pretend an older rust-v wrote the checkpoint.
+    let mut c = rust_v::checkpoint::Checkpoint::read(&ckpt).unwrap();
+    c.crate_version = "0.0.1".into();
+    c.write(&ckpt).unwrap();
+    let o = run(&["resume", s(&ckpt), "-q", "--spp", "2"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("warning") && err.contains("0.0.1"), "a version warning under --quiet: {err:?}");
+    assert_eq!(err.lines().count(), 1, "only the warning: {err}");
+}
+
+// ---------------------------------------------------------------------------
+// 10. Resume knows all its inputs.
+
+#[test]
+fn resume_and_merge_refuse_changed_meshes() {
+    let d = temp_dir("hostile-inputs");
+    let scene = scene_in(&d, MESH_SCENE);
+    let mesh = d.join("tri.obj");
+    std::fs::write(&mesh, TRI_OBJ).unwrap();
+    let part = |name: &str, passes: &str| {
+        let ck = d.join(format!("{name}.ckpt"));
+        let o = run(&[
+            "render",
+            s(&scene),
+            "-q",
+            "-o",
+            s(&d.join(format!("{name}.png"))),
+            "--checkpoint",
+            s(&ck),
+            "--passes",
+            passes,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        ck
+    };
+    let a = part("a", "0..1");
+    std::fs::write(&mesh, TRI_OBJ.replace("v 0 1 0", "v 0 0.9 0")).unwrap();
+    let b = part("b", "1..2");
+    let e = one_error(&run(&["resume", s(&a), "-q"]), 1);
+    assert!(e.contains("changed") && e.contains("mesh"), "{e}");
+    let o = run(&["resume", s(&a), "-q", "--force"]);
+    assert!(o.status.success() && stderr(&o).contains("warning"), "{}", stderr(&o));
+    let e = one_error(&run(&["merge", s(&a), s(&b), "-o", s(&d.join("m.png"))]), 1);
+    assert!(e.contains("different scene"), "{e}");
+    // A spectrum file is an input too.
+    std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.8\n").unwrap();
+    std::fs::write(&scene, SCENE.replace("Constant(0.5)", "File(\"refl.csv\")")).unwrap();
+    let c = part("c", "0..1");
+    std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.7\n").unwrap();
+    let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
+    assert!(e.contains("changed"), "{e}");
+}
