@@ -12,17 +12,39 @@
 //! refracts at its own index, a larger packet (which reaches a dispersive
 //! surface only when dispersion is off) at the index at 589.3 nm.
 //!
+//! **Rough glass** (`roughness: A`, GGX α, 0 = smooth): a microfacet
+//! interface with reflection and transmission ([`super::rough_dielectric`]);
+//! below α = 1e-3 it is the smooth model exactly. A dispersive rough glass
+//! still splits wavelengths in `auto` and `spectral` ([`super::Dispersion`]).
+//!
+//! **Absorption** (`absorption: SPECTRUM`, σ per scene unit per bin): light
+//! travelling a distance `d` inside keeps `exp(−σ d)` (Beer-Lambert). The
+//! integrators apply it to every path segment that ends on this surface from
+//! the inside (the side opposite the normal), which is every segment inside a
+//! closed glass unless it ends on another object inside it (see README,
+//! "Materials").
+//!
+//! **Coating** (`coating: ThinFilm(thickness_nm:, ior:)`, smooth glass only):
+//! the film's Airy reflectance per wavelength replaces Fresnel's
+//! ([`super::thin_film`]); the film is thin, so the ray refracts as through
+//! the bare interface.
+//!
 //! ```ron
 //! "glass": Dielectric(ior: Named("N-BK7")),
+//! "coated_lens": Dielectric(ior: Named("N-BK7"), coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))),
 //! "crown": Dielectric(ior: Constant(1.5)),
 //! "flint": Dielectric(ior: Cauchy(a: 1.67, b: 0.0074)),
+//! "frosted": Dielectric(ior: Constant(1.5), roughness: 0.15),
+//! "green_glass": Dielectric(ior: Named("N-BK7"), absorption: Samples([...36 values per unit length...])),
 //! ```
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-use super::{BsdfSample, Ior, fresnel_dielectric, refract};
-use crate::color::Sampled;
+use super::microfacet::{Ggx, SMOOTH_ALPHA};
+use super::thin_film::{ThinFilm, airy};
+use super::{BsdfSample, Ior, fresnel_dielectric, refract, rough_dielectric};
 use crate::color::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, bin_lambda_nm};
+use crate::color::{Sampled, Spectrum};
 use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM};
 
 /// A smooth dielectric; the outside (the side the normal points to) is the
@@ -36,6 +58,12 @@ pub struct Dielectric {
     bin_ior: [f32; N_BINS],
     /// The index at the reference wavelength, 589.3 nm.
     reference_ior: f32,
+    /// GGX α of the interface (below 1e-3: smooth).
+    alpha: f32,
+    /// Absorption coefficient inside, per scene unit (`None`: clear).
+    absorption: Option<Spectrum>,
+    /// A thin film on the outside of a smooth glass (`None`: bare).
+    coating: Option<ThinFilm>,
 }
 
 impl Dielectric {
@@ -43,7 +71,89 @@ impl Dielectric {
     pub fn new(ior: Ior) -> Self {
         let bin_ior = std::array::from_fn(|b| ior.at(bin_lambda_nm(b)));
         let reference_ior = ior.at(REFERENCE_LAMBDA_NM);
-        Dielectric { ior, bin_ior, reference_ior }
+        Dielectric { ior, bin_ior, reference_ior, alpha: 0.0, absorption: None, coating: None }
+    }
+
+    /// The same glass with a rough (GGX α) interface.
+    pub fn with_roughness(mut self, alpha: f32) -> Self {
+        self.alpha = alpha;
+        self
+    }
+
+    /// The same glass absorbing `sigma` per unit length inside (zero: clear).
+    pub fn with_absorption(mut self, sigma: Spectrum) -> Self {
+        self.absorption = if sigma.is_black() { None } else { Some(sigma) };
+        self
+    }
+
+    /// The same (smooth) glass under a thin film: its reflectance becomes the
+    /// film's Airy reflectance per wavelength (the loader refuses a coating
+    /// on rough glass).
+    pub fn with_coating(mut self, film: ThinFilm) -> Self {
+        self.coating = Some(film);
+        self
+    }
+
+    /// The reflectance for incidence cosine `cos` (negative: from inside),
+    /// relative index `eta` and fractional bin position `pos`: bare Fresnel,
+    /// or the coating's Airy reflectance (incident medium and substrate
+    /// swapped from inside; total internal reflection gives 1 unless the film
+    /// frustrates it).
+    #[inline]
+    pub fn reflectance_at(&self, cos: f32, eta: f32, pos: f32) -> f32 {
+        match &self.coating {
+            None => fresnel_dielectric(cos, eta),
+            Some(film) => {
+                let lambda = LAMBDA_MIN_NM + LAMBDA_STEP_NM * pos;
+                let nf = film.eta_at(pos);
+                let (ni, nt) = if cos >= 0.0 { (1.0, eta) } else { (eta, 1.0) };
+                airy(cos.abs(), ni, nf, film.thickness_nm, nt, 0.0, lambda).0
+            }
+        }
+    }
+
+    /// True when the interface is smooth (a delta model).
+    #[inline]
+    pub fn is_smooth(&self) -> bool {
+        self.alpha.is_nan() || self.alpha < SMOOTH_ALPHA
+    }
+
+    /// The absorption coefficient inside, when the glass absorbs.
+    #[inline]
+    pub fn absorption(&self) -> Option<&Spectrum> {
+        self.absorption.as_ref()
+    }
+
+    /// `f(wo, wi)` for index `eta` (0 for the smooth model).
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+        if self.is_smooth() { 0.0 } else { rough_dielectric::eval(Ggx { alpha: self.alpha }, wo, wi, eta) }
+    }
+
+    /// The pdf of `sample` choosing `wi`, for index `eta` (0 for the smooth model).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+        if self.is_smooth() { 0.0 } else { rough_dielectric::pdf(Ggx { alpha: self.alpha }, wo, wi, eta) }
+    }
+
+    /// Samples the smooth or rough interface for index `eta`.
+    #[inline]
+    pub fn sample_any<const N: usize>(
+        &self,
+        wo: Vec3,
+        u: Vec2,
+        uc: f32,
+        eta: f32,
+        lambdas: &Lambdas<N>,
+    ) -> Option<BsdfSample<N>> {
+        if self.coating.is_some() {
+            return self.sample_coated(wo, uc, eta, lambdas);
+        }
+        if self.is_smooth() {
+            return self.sample(wo, uc, eta);
+        }
+        let s = rough_dielectric::sample(Ggx { alpha: self.alpha }, wo, u, uc, eta)?;
+        Some(BsdfSample { wi: s.wi, f: Sampled::splat(s.f), pdf: s.pdf, is_delta: false, eta: s.etap })
     }
 
     /// The index of refraction of the inside.
@@ -80,7 +190,42 @@ impl Dielectric {
     /// direction `wo` (local frame) outside or inside.
     #[inline]
     pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
-        Sampled(std::array::from_fn(|i| fresnel_dielectric(wo.z, self.eta_at(lambdas.pos[i]))))
+        Sampled(std::array::from_fn(|i| self.reflectance_at(wo.z, self.eta_at(lambdas.pos[i]), lambdas.pos[i])))
+    }
+
+    /// Samples a coated smooth interface: each wavelength has its own
+    /// reflectance `R(λ)` (the film's), so reflection is chosen with the
+    /// packet's mean `P` and weighted `R(λ) / P`, refraction (at index `eta`)
+    /// with `1 − P` and weighted `(1 − R(λ)) / ((1 − P) η²)`.
+    #[inline]
+    fn sample_coated<const N: usize>(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        eta: f32,
+        lambdas: &Lambdas<N>,
+    ) -> Option<BsdfSample<N>> {
+        if wo.z.abs() < f32::MIN_POSITIVE {
+            return None;
+        }
+        let r = Sampled::<N>(std::array::from_fn(|i| self.reflectance_at(wo.z, eta, lambdas.pos[i])));
+        let p = (r.0.iter().sum::<f32>() / N as f32).clamp(0.0, 1.0);
+        let refracted = refract(wo, Vec3::Z, eta);
+        if uc < p || p >= 1.0 || refracted.is_none() {
+            if p.is_nan() || p <= 0.0 {
+                return None;
+            }
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            // Without a refracted direction every wavelength reflects: weight R / P with P = 1.
+            let pdf = if refracted.is_none() { 1.0 } else { p };
+            return Some(BsdfSample { wi, f: r / wi.z.abs(), pdf, is_delta: true, eta: 1.0 });
+        }
+        let (wi, etap) = refracted?;
+        if wi.z.abs() < f32::MIN_POSITIVE {
+            return None;
+        }
+        let t = Sampled(r.0.map(|x| 1.0 - x));
+        Some(BsdfSample { wi, f: t / (wi.z.abs() * etap * etap), pdf: 1.0 - p, is_delta: true, eta: etap })
     }
 
     /// The refraction alone for index `eta`, as a sample of probability 1
@@ -100,7 +245,7 @@ impl Dielectric {
         Some(BsdfSample { wi, f: Sampled::splat(f), pdf: 1.0, is_delta: true, eta: etap })
     }
 
-    /// Samples reflection or refraction for index `eta` (inside / outside).
+    /// Samples reflection or refraction of the smooth interface for index `eta` (inside / outside).
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, uc: f32, eta: f32) -> Option<BsdfSample<N>> {
         // Below the smallest normal f32, 1 / |cos θ| overflows to infinity.

@@ -20,29 +20,41 @@
 //!   reference wavelength, 589.3 nm (only `path` and `whitted`, which do not
 //!   split, let one reach a dispersive surface).
 //!
-//! Diffuse models are two-sided: they reflect into whichever hemisphere `wo`
-//! is in. The dielectric is oriented: `+z` is outside (the side the geometric
+//! Diffuse models, conductors and plastic are two-sided: they reflect into
+//! whichever hemisphere `wo` is in; a thin sheet is symmetric. The dielectric is oriented: `+z` is outside (the side the geometric
 //! normal points to), so `wo.z < 0` means the path is inside the glass.
 
+mod conductor;
 mod dielectric;
 mod fresnel;
 mod ior;
 mod lambertian;
+mod metals;
+pub mod microfacet;
 mod oren_nayar;
+mod plastic;
+mod rough_dielectric;
 mod specular;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_rough;
+mod thin_film;
 
+pub use conductor::Conductor;
 pub use dielectric::Dielectric;
-pub use fresnel::{fresnel_dielectric, refract};
+pub use fresnel::{fresnel_conductor, fresnel_dielectric, refract};
 pub use ior::{Ior, NAMED_GLASSES, named_glass};
 pub use lambertian::Lambertian;
+pub use metals::{NAMED_METALS, named_metal};
 pub use oren_nayar::OrenNayar;
+pub use plastic::Plastic;
 pub use specular::Mirror;
+pub use thin_film::{ThinFilm, ThinSheet, airy};
 
 use glam::{Vec2, Vec3};
 
-use crate::color::Sampled;
+use crate::color::{Sampled, Spectrum};
 use crate::spectral::Lambdas;
 
 /// A sampled direction with its value and pdf.
@@ -74,6 +86,12 @@ pub enum Bxdf {
     Mirror(Mirror),
     /// A smooth dielectric interface (glass, water): Fresnel reflection and refraction.
     Dielectric(Dielectric),
+    /// A metal with a complex index, smooth or rough (GGX).
+    Conductor(Conductor),
+    /// A dielectric coat over a diffuse base (coated diffuse).
+    Plastic(Plastic),
+    /// A free-standing thin film (soap film): interference reflection, straight transmission.
+    ThinSheet(ThinSheet),
 }
 
 impl Bxdf {
@@ -83,7 +101,10 @@ impl Bxdf {
         match self {
             Bxdf::Lambertian(m) => m.eval(wo, wi, lambdas),
             Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
-            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => Sampled::splat(0.0),
+            Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
+            Bxdf::Plastic(m) => m.eval(wo, wi, lambdas),
+            Bxdf::Dielectric(m) => Sampled::splat(m.eval(wo, wi, m.eta_for(lambdas))),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => Sampled::splat(0.0),
         }
     }
 
@@ -96,23 +117,35 @@ impl Bxdf {
             Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
-            Bxdf::Dielectric(m) => m.sample(wo, uc, m.eta_for(lambdas)),
+            Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas), lambdas),
+            Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
+            Bxdf::Plastic(m) => m.sample(wo, u, uc, lambdas),
+            Bxdf::ThinSheet(m) => m.sample(wo, uc, lambdas),
         }
     }
 
-    /// The pdf of sampling `wi` given `wo` (zero for delta models).
+    /// The pdf of sampling `wi` given `wo` for the packet `lambdas` (zero
+    /// for delta models; rough glass samples at the packet's index, as `sample`).
     #[inline]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub fn pdf<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> f32 {
         match self {
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
-            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Dielectric(_) => 0.0,
+            Bxdf::Conductor(m) => m.pdf(wo, wi),
+            Bxdf::Plastic(m) => m.pdf(wo, wi, lambdas),
+            Bxdf::Dielectric(m) => m.pdf(wo, wi, m.eta_for(lambdas)),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => 0.0,
         }
     }
 
     /// True when the model's directions are all delta (no light sampling pays).
     #[inline]
     pub fn is_delta(&self) -> bool {
-        matches!(self, Bxdf::Mirror(_) | Bxdf::Dielectric(_))
+        match self {
+            Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => true,
+            Bxdf::Dielectric(d) => d.is_smooth(),
+            Bxdf::Conductor(c) => c.is_smooth(),
+            Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) | Bxdf::Plastic(_) => false,
+        }
     }
 
     /// How the model disperses, when `sample`'s direction depends on the
@@ -131,6 +164,17 @@ impl Bxdf {
         self.dispersion().is_some()
     }
 
+    /// The absorption coefficient (per unit length) inside the model, for
+    /// an absorbing dielectric: the integrators attenuate every segment that
+    /// reaches this surface from its inside by `exp(−σ t)`.
+    #[inline]
+    pub fn absorption(&self) -> Option<&Spectrum> {
+        match self {
+            Bxdf::Dielectric(d) => d.absorption(),
+            _ => None,
+        }
+    }
+
     /// True when the model absorbs everything (a path ends here).
     #[inline]
     pub fn is_black(&self) -> bool {
@@ -146,6 +190,15 @@ impl Bxdf {
 pub struct Dispersion<'a>(&'a Dielectric);
 
 impl Dispersion<'_> {
+    /// True for smooth glass: its reflection sends every wavelength the same
+    /// way, so `auto` may keep the full spectrum there. A rough dispersive
+    /// glass is instead split into single wavelengths before sampling (each
+    /// then samples, and takes its light sample, at its own index).
+    #[inline]
+    pub fn is_smooth(&self) -> bool {
+        self.0.is_smooth()
+    }
+
     /// The relative index at the reference wavelength, 589.3 nm.
     #[inline]
     pub fn reference_eta(&self) -> f32 {
@@ -156,6 +209,23 @@ impl Dispersion<'_> {
     #[inline]
     pub fn eta_at(&self, pos: f32) -> f32 {
         self.0.eta_at(pos)
+    }
+
+    /// The reflectance at incidence cosine `cos` for the bin at fractional
+    /// position `pos`, at that bin's index (the film's where the glass is coated).
+    #[inline]
+    pub fn reflectance_at(&self, cos: f32, pos: f32) -> f32 {
+        self.0.reflectance_at(cos, self.0.eta_at(pos), pos)
+    }
+
+    /// The reflectance at the reference wavelength (589.3 nm) for incidence cosine `cos`.
+    #[inline]
+    pub fn reference_reflectance(&self, cos: f32) -> f32 {
+        self.0.reflectance_at(
+            cos,
+            self.0.reference_eta(),
+            (crate::spectral::REFERENCE_LAMBDA_NM - crate::color::LAMBDA_MIN_NM) / crate::color::LAMBDA_STEP_NM,
+        )
     }
 
     /// The reflectance at each of the packet's wavelengths for `wo`.
@@ -199,7 +269,7 @@ pub(crate) mod test_util {
                 for i in 0..36 {
                     assert!((f[i] - bs.f[i]).abs() <= 1e-5 * f[i].abs().max(1.0), "eval != sample at bin {i}");
                 }
-                assert!((b.pdf(wo, bs.wi) - bs.pdf).abs() <= 1e-4 * bs.pdf);
+                assert!((b.pdf(wo, bs.wi, &l) - bs.pdf).abs() <= 1e-4 * bs.pdf);
             }
             let w = bs.f * (bs.wi.z.abs() / bs.pdf);
             albedo += w;

@@ -226,6 +226,6 @@ pub(crate) fn sample_direct<const N: usize>(
         return zero;
     }
     let pdf_light = pmf * ls.pdf;
-    let weight = if ls.is_delta || !mis { 1.0 } else { power_heuristic(pdf_light, bxdf.pdf(sh.wo, wi_local)) };
+    let weight = if ls.is_delta || !mis { 1.0 } else { power_heuristic(pdf_light, bxdf.pdf(sh.wo, wi_local, lambdas)) };
     f * lambdas.sample(light.spectrum()) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
 }

@@ -3,7 +3,9 @@
 //! dispersive surfaces (thesis §2.4.1-2.4.2, pbrt-v4 §13.4).
 //!
 //! One walk serves the `path`, `spectral` and `auto` integrators:
-//! 1. intersect; at an emitter add `β · L_e`, MIS-weighted against light
+//! 0. intersect; a segment that reaches an absorbing dielectric from its
+//!    inside is attenuated by `exp(−σ t)` (Beer-Lambert);
+//! 1. at an emitter add `β · L_e`, MIS-weighted against light
 //!    sampling unless the previous bounce was delta (or this is the camera ray);
 //! 2. stop after `max_bounces` scattering events;
 //! 3. at a dispersive surface, when dispersion is on and the packet has more
@@ -13,13 +15,16 @@
 //!    between reflection, which is the same direction for every wavelength
 //!    and keeps the full spectrum, and refraction, which collapses the path
 //!    to `C` bins drawn in proportion to throughput × visual importance
-//!    (`PathTracer::collapse`);
+//!    (`PathTracer::collapse`). At a *rough* dispersive dielectric every
+//!    lobe's direction depends on the wavelength, so `auto` collapses the
+//!    whole path there, to `C` bins drawn the same way, each walking on from
+//!    this hit (light sample and BSDF sample at its own index);
 //! 4. at a non-delta surface add direct light (one light sample, MIS);
 //! 5. sample the BSDF for the next direction and update `β ← β f |cos| / pdf`;
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
-use crate::bxdf::{BsdfSample, Dispersion, fresnel_dielectric};
+use crate::bxdf::{BsdfSample, Dispersion};
 use crate::color::{N_BINS, Sampled};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
@@ -103,6 +108,14 @@ impl PathTracer {
         loop {
             let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
+            // 0. Beer-Lambert absorption along a segment inside an absorbing
+            //    dielectric (once: a split walk starts at a hit already counted).
+            if add_emission
+                && let Some(sigma) = scene.materials[object.material as usize].absorption()
+                && ray.dir.dot(hit.n) > 0.0
+            {
+                w.beta *= (lambdas.sample(sigma) * -hit.t).exp();
+            }
             // 1. Emission, MIS-weighted against the light sample taken at the previous vertex.
             if add_emission && let Some(index) = object.light {
                 let light = &scene.lights[index as usize];
@@ -133,12 +146,27 @@ impl PathTracer {
             if N > 1
                 && let Some(dispersion) = dispersion
             {
-                if N == N_BINS && lambdas.readout == Readout::Spectral {
+                if N == N_BINS && lambdas.readout == Readout::Spectral && dispersion.is_smooth() {
                     // `auto`: reflection keeps the full spectrum, refraction collapses.
                     match self.collapse(scene, ray, si, &sh, dispersion, &w, lambdas, sampler, &mut split) {
                         Some(fr) => reflect = Some(fr),
                         None => break,
                     }
+                } else if N == N_BINS && lambdas.readout == Readout::Spectral {
+                    // `auto` at rough dispersive glass: every lobe's direction
+                    // depends on the wavelength, so the whole path collapses here.
+                    let importance = bin_importance();
+                    let Some(dist) = BinDistribution::new(|b| w.beta[b] * importance[b]) else {
+                        break;
+                    };
+                    let u = sampler.next_1d();
+                    for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
+                        let one = Walk { beta: Sampled([w.beta[bin]]), ..copy_walk(&w) };
+                        let l1 =
+                            Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };
+                        split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::Split);
+                    });
+                    break;
                 } else {
                     for i in 0..N {
                         let one = Walk { beta: Sampled([w.beta[i]]), ..copy_walk(&w) };
@@ -231,7 +259,7 @@ impl PathTracer {
         let importance = bin_importance();
         let cos = sh.wo.z;
         let (p_reflect, all_fr) = if cos > 0.0 && glass.reference_eta() >= 1.0 {
-            (fresnel_dielectric(cos, glass.reference_eta()), None)
+            (glass.reference_reflectance(cos), None)
         } else {
             let fr = glass.reflectance(sh.wo, lambdas);
             let (mut total, mut reflected) = (0.0f32, 0.0f32);
@@ -255,7 +283,7 @@ impl PathTracer {
         for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
             let fr = match all_fr {
                 Some(fr) => fr[bin],
-                None => fresnel_dielectric(cos, glass.eta_at(lambdas.pos[bin])),
+                None => glass.reflectance_at(cos, lambdas.pos[bin]),
             };
             let one = Walk { beta: Sampled([w.beta[bin] * (1.0 - fr) / p_refract]), ..copy_walk(w) };
             let l1 = Lambdas { pos: [bin as f32], weight: lambdas.weight * weight, readout: Readout::Spectral };

@@ -5,7 +5,9 @@
 //! lobe); at the first non-specular surface add the direct light from one light
 //! sample and stop. Emitters are seen directly or through specular chains.
 //! Indirect diffuse light and caustics are missing by construction: that is the
-//! method's documented shortfall, not a bug. Dispersive glass refracts every
+//! method's documented shortfall, not a bug. Rough metals and rough glass are
+//! not specular: they end the chain like a diffuse surface (direct light
+//! only). Absorbing glass attenuates the chain's segments inside it. Dispersive glass refracts every
 //! wavelength like 589.3 nm (no rainbow), as in the `path` integrator: its
 //! packets are the full spectrum, which a BxDF samples at that wavelength.
 
@@ -39,6 +41,12 @@ impl Whitted {
         while let Some(si) = scene.intersect(&ray, f32::INFINITY) {
             let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
+            // Beer-Lambert absorption along a segment inside an absorbing dielectric.
+            if let Some(sigma) = scene.materials[object.material as usize].absorption()
+                && ray.dir.dot(hit.n) > 0.0
+            {
+                beta *= (lambdas.sample(sigma) * -hit.t).exp();
+            }
             // Emitters seen directly or through specular surfaces only.
             if let Some(index) = object.light {
                 let light = &scene.lights[index as usize];

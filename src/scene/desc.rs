@@ -175,13 +175,74 @@ pub enum MaterialDesc {
         /// Reflectance.
         reflectance: SpectrumDesc,
     },
-    /// Smooth glass.
+    /// Glass: `Dielectric(ior: Named("N-BK7"))`, optionally rough
+    /// (`roughness: A`, GGX α) and absorbing (`absorption: SPECTRUM`, per unit length).
     Dielectric {
         /// Index of refraction of the inside.
+        ior: IorDesc,
+        /// GGX α in [0, 1] (default 0: smooth).
+        #[serde(default)]
+        roughness: f32,
+        /// Absorption coefficient inside, per scene unit (default: clear).
+        #[serde(default)]
+        absorption: Option<SpectrumDesc>,
+        /// A thin film on the outside (smooth glass only): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
+        #[serde(default)]
+        coating: Option<CoatingDesc>,
+    },
+    /// A metal: `Conductor(metal: "Au")` (Au, Ag, Cu, Al, Cr, CuZn) or
+    /// `Conductor(eta: SPECTRUM, k: SPECTRUM)`, optionally `roughness: A`
+    /// (GGX α as Mitsuba's `alpha`; 0, the default, is a smooth metal).
+    Conductor {
+        /// A named metal (exclusive with `eta` and `k`).
+        #[serde(default)]
+        metal: Option<String>,
+        /// The real part of the complex index, per wavelength.
+        #[serde(default)]
+        eta: Option<SpectrumDesc>,
+        /// The extinction coefficient (imaginary part), per wavelength.
+        #[serde(default)]
+        k: Option<SpectrumDesc>,
+        /// GGX α in [0, 1] (default 0: smooth).
+        #[serde(default)]
+        roughness: f32,
+        /// A thin film on the metal: `coating: ThinFilm(thickness_nm: 300, ior: Constant(1.45))`.
+        #[serde(default)]
+        coating: Option<CoatingDesc>,
+    },
+    /// Coated diffuse: a dielectric coat (index `ior`, GGX `roughness`,
+    /// default 0: smooth) over a Lambertian base of `reflectance`.
+    Plastic {
+        /// The base's diffuse reflectance.
+        reflectance: SpectrumDesc,
+        /// The coat's index of refraction.
+        ior: IorDesc,
+        /// GGX α of the coat in [0, 1] (default 0: smooth).
+        #[serde(default)]
+        roughness: f32,
+    },
+    /// A free-standing thin film (soap film): `ThinSheet(thickness_nm: 400, ior: Constant(1.33))`.
+    ThinSheet {
+        /// Thickness in nm.
+        thickness_nm: f32,
+        /// The film's index of refraction.
         ior: IorDesc,
     },
     /// Absorbs everything.
     Black,
+}
+
+/// A coating on a surface.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CoatingDesc {
+    /// A thin film of `thickness_nm` and index `ior` (interference per wavelength).
+    ThinFilm {
+        /// Thickness in nm.
+        thickness_nm: f32,
+        /// The film's index of refraction.
+        ior: IorDesc,
+    },
 }
 
 /// A shape.

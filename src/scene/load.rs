@@ -8,9 +8,12 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::desc::{IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
+use super::desc::{CoatingDesc, IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
 use super::{Object, Scene};
-use crate::bxdf::{Bxdf, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, OrenNayar, named_glass};
+use crate::bxdf::{
+    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, Plastic, ThinFilm,
+    ThinSheet, named_glass, named_metal,
+};
 use crate::camera::Camera;
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
@@ -347,11 +350,97 @@ impl Ctx<'_> {
             MaterialDesc::Mirror { reflectance } => {
                 Bxdf::Mirror(Mirror { reflectance: self.reflectance(&format!("{field}.reflectance"), reflectance)? })
             }
-            MaterialDesc::Dielectric { ior } => {
-                Bxdf::Dielectric(Dielectric::new(self.ior(&format!("{field}.ior"), ior)?))
+            MaterialDesc::Dielectric { ior, roughness, absorption, coating } => {
+                let mut d = Dielectric::new(self.ior(&format!("{field}.ior"), ior)?)
+                    .with_roughness(self.roughness(&format!("{field}.roughness"), *roughness)?);
+                if let Some(a) = absorption {
+                    d = d.with_absorption(self.spectrum(&format!("{field}.absorption"), a)?);
+                }
+                if let Some(CoatingDesc::ThinFilm { thickness_nm, ior }) = coating {
+                    if !d.is_smooth() {
+                        return Err(self.err(
+                            format!("{field}.coating"),
+                            "a coating is supported on smooth glass only (roughness below 0.001)",
+                        ));
+                    }
+                    d = d.with_coating(self.thin_film(&format!("{field}.coating"), *thickness_nm, ior)?);
+                }
+                Bxdf::Dielectric(d)
+            }
+            MaterialDesc::Conductor { metal, eta, k, roughness, coating } => {
+                let (eta, k) = match (metal, eta, k) {
+                    (Some(name), None, None) => named_metal(name).ok_or_else(|| {
+                        let names: Vec<&str> = NAMED_METALS.iter().map(|m| m.0).collect();
+                        self.err(
+                            format!("{field}.metal"),
+                            format!("unknown metal \"{name}\"; expected one of: {}", names.join(", ")),
+                        )
+                    })?,
+                    (None, Some(eta), Some(k)) => {
+                        let eta_s = self.spectrum(&format!("{field}.eta"), eta)?;
+                        if eta_s.min_value() <= 0.0 {
+                            return Err(
+                                self.err(format!("{field}.eta"), "expected a positive index at every wavelength")
+                            );
+                        }
+                        (eta_s, self.spectrum(&format!("{field}.k"), k)?)
+                    }
+                    _ => {
+                        return Err(self.err(field, "expected either `metal: \"Au\"` or both `eta:` and `k:` spectra"));
+                    }
+                };
+                let coating = match coating {
+                    None => None,
+                    Some(CoatingDesc::ThinFilm { thickness_nm, ior }) => {
+                        Some(self.thin_film(&format!("{field}.coating"), *thickness_nm, ior)?)
+                    }
+                };
+                let alpha = self.roughness(&format!("{field}.roughness"), *roughness)?;
+                Bxdf::Conductor(Conductor { eta, k, alpha, coating })
+            }
+            MaterialDesc::Plastic { reflectance, ior, roughness } => {
+                let ior = self.ior(&format!("{field}.ior"), ior)?;
+                for b in 0..N_BINS {
+                    let n = ior.at(color::bin_lambda_nm(b));
+                    if n < 1.0 {
+                        return Err(self.err(
+                            format!("{field}.ior"),
+                            format!("a coat's index must be at least 1, found {n} at {} nm", color::bin_lambda_nm(b)),
+                        ));
+                    }
+                }
+                Bxdf::Plastic(Plastic::new(
+                    self.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                    &ior,
+                    self.roughness(&format!("{field}.roughness"), *roughness)?,
+                ))
+            }
+            MaterialDesc::ThinSheet { thickness_nm, ior } => {
+                Bxdf::ThinSheet(ThinSheet { film: self.thin_film(field, *thickness_nm, ior)? })
             }
             MaterialDesc::Black => Bxdf::Black,
         })
+    }
+
+    /// A thin film: a thickness in [0, 1e7] nm and an index of at least 1.
+    fn thin_film(&self, field: &str, thickness_nm: f32, ior: &IorDesc) -> Result<ThinFilm> {
+        if !(thickness_nm.is_finite() && (0.0..=1e7).contains(&thickness_nm)) {
+            return Err(self.err(
+                format!("{field}.thickness_nm"),
+                format!("expected a thickness in nm in [0, 1e7], found {thickness_nm}"),
+            ));
+        }
+        let ior = self.ior(&format!("{field}.ior"), ior)?;
+        Ok(ThinFilm::new(thickness_nm, &ior))
+    }
+
+    /// A GGX α: a number in [0, 1] (0 is smooth).
+    fn roughness(&self, field: &str, alpha: f32) -> Result<f32> {
+        if alpha.is_finite() && (0.0..=1.0).contains(&alpha) {
+            Ok(alpha)
+        } else {
+            Err(self.err(field, format!("expected a GGX alpha in [0, 1], found {alpha}")))
+        }
     }
 
     fn shape(&self, field: &str, d: &ShapeDesc) -> Result<Shape> {

@@ -11,6 +11,7 @@ use rust_v::film::Film;
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 mod glass;
+mod materials;
 mod surfaces;
 
 use crate::common::{mean_and_stderr, render_str, temp_dir};
