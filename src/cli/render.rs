@@ -8,7 +8,7 @@
 //! film fits in the machine's memory.
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
 use rust_v::color::ColorSpace;
@@ -81,15 +81,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         },
     };
     checkpoint.film.set_color_space(args.color_space);
-    let plan = SessionPlan {
-        checkpoint_path,
-        final_checkpoint: args.checkpoint.checkpoint.is_some(),
-        every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
-        output,
-        threads: args.run.threads,
-        quiet: args.run.quiet,
-        budget: args.time.map(Duration::from_secs_f64),
-    };
+    let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, args.time);
     session.run(&scene, checkpoint, passes.end, &plan)
 }
 
@@ -158,15 +150,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     let resumed = [("checkpoint resumed", path.as_path())];
     let extra: &[(&str, &Path)] = if args.checkpoint.checkpoint.is_some() { &resumed } else { &[] };
     check_files(&ckpt.scene_path, &scene, extra, &output, &checkpoint_path, ckpt.film.spectral_sums().is_some())?;
-    let plan = SessionPlan {
-        checkpoint_path,
-        final_checkpoint: args.checkpoint.checkpoint.is_some(),
-        every: args.checkpoint.checkpoint_every.map(Duration::from_secs_f64),
-        output,
-        threads: args.run.threads,
-        quiet: args.run.quiet,
-        budget: None,
-    };
+    let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, None);
     session.run(&scene, ckpt, end, &plan)
 }
 

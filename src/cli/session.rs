@@ -39,6 +39,7 @@ use rust_v::film::Film;
 use rust_v::render::{Limits, render};
 use rust_v::scene::Scene;
 
+use super::args::{CheckpointArgs, RunArgs};
 use super::console::{ProgressView, report, thread_pool};
 
 /// Where a session writes and how it runs.
@@ -57,6 +58,29 @@ pub struct SessionPlan {
     pub quiet: bool,
     /// Stop after this much render time, in whole passes (`render --time`).
     pub budget: Option<Duration>,
+}
+
+impl SessionPlan {
+    /// The plan of `render` or `resume`: checkpoints at `checkpoint_path`
+    /// (also at the end when `--checkpoint` was given), the image at `output`,
+    /// and an optional time budget in seconds.
+    pub fn new(
+        checkpoint_path: PathBuf,
+        checkpoint: &CheckpointArgs,
+        output: PathBuf,
+        run: &RunArgs,
+        budget_seconds: Option<f64>,
+    ) -> SessionPlan {
+        SessionPlan {
+            checkpoint_path,
+            final_checkpoint: checkpoint.checkpoint.is_some(),
+            every: checkpoint.checkpoint_every.map(Duration::from_secs_f64),
+            output,
+            threads: run.threads,
+            quiet: run.quiet,
+            budget: budget_seconds.map(Duration::from_secs_f64),
+        }
+    }
 }
 
 /// The signal flags of a running render; dropping it restores default handling.

@@ -8,16 +8,15 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use super::desc::{CoatingDesc, IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, SpectrumDesc, V3};
+use super::desc::{CoatingDesc, IorDesc, LightDesc, MaterialDesc, ScaleDesc, SceneDesc, ShapeDesc, V3};
 use super::{Object, Scene};
 use crate::bxdf::{
-    Bxdf, Conductor, Dielectric, Ior, Lambertian, Mirror, NAMED_GLASSES, NAMED_METALS, OrenNayar, Plastic, ThinFilm,
-    ThinSheet, named_glass, named_metal,
+    Bxdf, Conductor, Dielectric, Lambertian, Mirror, NAMED_METALS, OrenNayar, Plastic, ThinFilm, ThinSheet, named_metal,
 };
 use crate::camera::Camera;
-use crate::color::{self, N_BINS, Spectrum};
+use crate::color::{self, N_BINS};
 use crate::error::{Error, Result};
-use crate::io::{Fnv1a, fnv1a, parse_mesh, parse_spectrum_file, read_input};
+use crate::io::{Fnv1a, fnv1a, parse_mesh, read_input};
 use crate::light::{AreaLight, BeamLight, DiskLight, DistantLight, Light, PointLight, SphereLight, SpotLight};
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Bubble, Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere, Transform};
@@ -131,7 +130,7 @@ fn key_positions(text: &str, name: &str) -> Vec<(usize, usize)> {
 }
 
 /// A file the scene reads besides itself.
-struct Input {
+pub(super) struct Input {
     /// The path as written in the scene.
     name: String,
     /// The path it resolves to.
@@ -140,38 +139,29 @@ struct Input {
     hash: u64,
 }
 
-/// What a spectrum describes: it decides what `Rgb(r, g, b)` means.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Role {
-    /// A reflectance: the uplifted colour itself, within [0, 1].
-    Reflectance,
-    /// An emission or intensity: the uplifted colour times D65.
-    Emission,
-}
-
-struct Ctx<'a> {
-    path: &'a Path,
-    dir: PathBuf,
+pub(super) struct Ctx<'a> {
+    pub(super) path: &'a Path,
+    pub(super) dir: PathBuf,
     /// Every file read so far, in order (for the scene's identity).
     inputs: RefCell<Vec<Input>>,
 }
 
 impl Ctx<'_> {
-    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
+    pub(super) fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
         Error::scene_field(self.path, field, message)
     }
 
     /// Reads a file the scene names (`rel`, relative to the scene file) for
     /// field `field`, and records it in the scene's identity. Only regular
     /// files are read.
-    fn read_input(&self, field: &str, rel: &str) -> Result<(PathBuf, Vec<u8>)> {
+    pub(super) fn read_input(&self, field: &str, rel: &str) -> Result<(PathBuf, Vec<u8>)> {
         let path = self.dir.join(rel);
         let bytes = read_input(&path).map_err(|e| self.err(field, e.to_string()))?;
         self.inputs.borrow_mut().push(Input { name: rel.to_string(), path: path.clone(), hash: fnv1a(&bytes) });
         Ok((path, bytes))
     }
 
-    fn positive(&self, field: &str, v: f32) -> Result<f32> {
+    pub(super) fn positive(&self, field: &str, v: f32) -> Result<f32> {
         if v.is_finite() && v > 0.0 && v <= MAX_MAGNITUDE {
             Ok(v)
         } else {
@@ -191,145 +181,6 @@ impl Ctx<'_> {
     fn direction(&self, field: &str, v: V3) -> Result<Vec3> {
         let v = self.vec(field, v)?;
         v.try_normalize().ok_or_else(|| self.err(field, "expected a non-zero direction"))
-    }
-
-    /// A text file the scene refers to (a spectrum table), read through
-    /// [`Ctx::read_input`] like every input: the resolved path and the text.
-    fn read_text_input(&self, field: &str, rel: &str) -> Result<(PathBuf, String)> {
-        let (path, bytes) = self.read_input(field, rel)?;
-        let text = String::from_utf8(bytes).map_err(|e| {
-            let at = e.utf8_error().valid_up_to();
-            self.err(field, format!("\"{}\": byte {at} is not UTF-8; expected a UTF-8 text file", path.display()))
-        })?;
-        Ok((path, text))
-    }
-
-    /// Checks a table's points (finite, wavelengths strictly increasing, at least one).
-    fn table(&self, field: &str, points: &[(f32, f32)]) -> Result<Spectrum> {
-        if points.is_empty() {
-            return Err(self.err(field, "expected at least one (nm, value) pair"));
-        }
-        for (k, w) in points.iter().enumerate() {
-            if !(w.0.is_finite() && w.1.is_finite() && w.0 > 0.0) {
-                return Err(self.err(
-                    format!("{field}[{k}]"),
-                    format!("expected a positive wavelength in nm and a finite value, found {w:?}"),
-                ));
-            }
-            if k > 0 && w.0 <= points[k - 1].0 {
-                return Err(self.err(
-                    format!("{field}[{k}]"),
-                    format!("wavelengths must increase: {} nm follows {} nm", w.0, points[k - 1].0),
-                ));
-            }
-        }
-        Ok(Spectrum::from_table(points))
-    }
-
-    /// A spectrum for emission or intensity (any non-negative values).
-    fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
-        self.spectrum_as(field, s, Role::Emission)
-    }
-
-    /// A spectrum in a role; the role decides what `Rgb` means.
-    fn spectrum_as(&self, field: &str, s: &SpectrumDesc, role: Role) -> Result<Spectrum> {
-        let out = match s {
-            SpectrumDesc::Constant(v) => Spectrum::splat(*v),
-            SpectrumDesc::Samples(v) => {
-                if v.len() != N_BINS {
-                    return Err(
-                        self.err(field, format!("expected 36 samples (380 to 730 nm every 10 nm), found {}", v.len()))
-                    );
-                }
-                Spectrum::from_fn(|i| v[i])
-            }
-            SpectrumDesc::ColorChecker(name) => color::color_checker(name).ok_or_else(|| {
-                self.err(
-                    field,
-                    format!(
-                        "unknown ColorChecker patch \"{name}\"; expected one of: {}",
-                        color::COLOR_CHECKER_NAMES.join(", ")
-                    ),
-                )
-            })?,
-            SpectrumDesc::D65 => color::d65(),
-            SpectrumDesc::EqualEnergy => color::equal_energy(),
-            SpectrumDesc::Blackbody(t) => color::blackbody(*t)
-                .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
-            SpectrumDesc::Scaled(k, inner) => self.spectrum_as(field, inner, role)? * *k,
-            SpectrumDesc::Table(points) => self.table(field, points)?,
-            SpectrumDesc::File(rel) => {
-                let (path, text) = self.read_text_input(field, rel)?;
-                let points = parse_spectrum_file(&text).map_err(|e| Error::Scene {
-                    path: path.clone(),
-                    position: Some((e.line, e.col)),
-                    field: field.to_string(),
-                    message: e.message,
-                })?;
-                self.table(field, &points).map_err(|e| match e {
-                    Error::Scene { field, message, .. } => {
-                        Error::Scene { path: path.clone(), position: None, field, message }
-                    }
-                    e => e,
-                })?
-            }
-            SpectrumDesc::Rgb(r, g, b) => {
-                let rgb = [*r, *g, *b];
-                let limit = if role == Role::Reflectance { 1.0 } else { MAX_MAGNITUDE };
-                if !rgb.iter().all(|v| v.is_finite() && (0.0..=limit).contains(v)) {
-                    return Err(
-                        self.err(field, format!("expected linear sRGB components in [0, {limit}], found {rgb:?}"))
-                    );
-                }
-                match role {
-                    Role::Reflectance => color::rgb_reflectance(rgb),
-                    Role::Emission => color::rgb_emission(rgb),
-                }
-            }
-            SpectrumDesc::Luminance(y, inner) => {
-                let s = self.spectrum_as(field, inner, role)?;
-                let have = s.to_xyz().y;
-                if !(y.is_finite() && *y >= 0.0 && *y <= MAX_MAGNITUDE) {
-                    return Err(self.err(field, format!("expected a luminance in [0, {MAX_MAGNITUDE:e}], found {y}")));
-                }
-                if !(have > 0.0 && have.is_finite()) {
-                    return Err(self.err(field, format!("cannot scale a spectrum of luminance {have} to {y}")));
-                }
-                s * (*y / have)
-            }
-        };
-        if out.has_nan_or_inf() || out.min_value() < 0.0 || out.max_value() > MAX_MAGNITUDE {
-            return Err(self.err(field, format!("expected finite, non-negative values up to {MAX_MAGNITUDE:e}")));
-        }
-        Ok(out)
-    }
-
-    fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
-        let r = self.spectrum_as(field, s, Role::Reflectance)?;
-        if r.max_value() > 1.0 {
-            return Err(self.err(field, format!("a reflectance must lie in [0, 1], found {}", r.max_value())));
-        }
-        Ok(r)
-    }
-
-    fn ior(&self, field: &str, d: &IorDesc) -> Result<Ior> {
-        let ior = match d {
-            IorDesc::Constant(n) => Ior::Constant(*n),
-            IorDesc::Cauchy { a, b } => Ior::Cauchy { a: *a, b: *b },
-            IorDesc::Sellmeier { b, c } => Ior::Sellmeier { b: [b[0], b[1], b[2], 0.0], c: [c[0], c[1], c[2], 0.0] },
-            IorDesc::Named(name) => named_glass(name).ok_or_else(|| {
-                let names: Vec<&str> = NAMED_GLASSES.iter().map(|g| g.0).collect();
-                self.err(field, format!("unknown glass \"{name}\"; expected one of: {}", names.join(", ")))
-            })?,
-        };
-        for lambda in [color::LAMBDA_MIN_NM, 550.0, color::bin_lambda_nm(N_BINS - 1)] {
-            let n = ior.at(lambda);
-            if !(n.is_finite() && n > 0.0) {
-                return Err(self
-                    .err(field, format!("the index of refraction at {lambda} nm is {n}; expected a positive number")));
-            }
-        }
-        Ok(ior)
     }
 
     fn material(&self, field: &str, d: &MaterialDesc) -> Result<Bxdf> {

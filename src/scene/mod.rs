@@ -9,6 +9,7 @@
 
 pub mod desc;
 mod load;
+mod spectra;
 
 pub use load::{load_scene, load_scene_str};
 

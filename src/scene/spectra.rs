@@ -1,0 +1,164 @@
+//! Spectra and indices of refraction in a scene file, checked: the
+//! `SpectrumDesc` forms (`Constant`, `Samples`, `Table`, `File`, `Rgb`,
+//! named spectra, `Blackbody`, `Luminance`, `Scaled`) become 36-bin
+//! [`Spectrum`]s, and `IorDesc` becomes an [`Ior`]. Part of the scene loader
+//! ([`super::load`]), split out to keep each file about one thing.
+
+use std::path::PathBuf;
+
+use super::desc::{IorDesc, SpectrumDesc};
+use super::load::{Ctx, MAX_MAGNITUDE};
+use crate::bxdf::{Ior, NAMED_GLASSES, named_glass};
+use crate::color::{self, N_BINS, Spectrum};
+use crate::error::{Error, Result};
+use crate::io::parse_spectrum_file;
+
+/// What a spectrum describes: it decides what `Rgb(r, g, b)` means.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// A reflectance: the uplifted colour itself, within [0, 1].
+    Reflectance,
+    /// An emission or intensity: the uplifted colour times D65.
+    Emission,
+}
+
+impl Ctx<'_> {
+    /// A text file the scene refers to (a spectrum table), read through
+    /// [`Ctx::read_input`] like every input: the resolved path and the text.
+    pub(super) fn read_text_input(&self, field: &str, rel: &str) -> Result<(PathBuf, String)> {
+        let (path, bytes) = self.read_input(field, rel)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            self.err(field, format!("\"{}\": byte {at} is not UTF-8; expected a UTF-8 text file", path.display()))
+        })?;
+        Ok((path, text))
+    }
+
+    /// Checks a table's points (finite, wavelengths strictly increasing, at least one).
+    pub(super) fn table(&self, field: &str, points: &[(f32, f32)]) -> Result<Spectrum> {
+        if points.is_empty() {
+            return Err(self.err(field, "expected at least one (nm, value) pair"));
+        }
+        for (k, w) in points.iter().enumerate() {
+            if !(w.0.is_finite() && w.1.is_finite() && w.0 > 0.0) {
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("expected a positive wavelength in nm and a finite value, found {w:?}"),
+                ));
+            }
+            if k > 0 && w.0 <= points[k - 1].0 {
+                return Err(self.err(
+                    format!("{field}[{k}]"),
+                    format!("wavelengths must increase: {} nm follows {} nm", w.0, points[k - 1].0),
+                ));
+            }
+        }
+        Ok(Spectrum::from_table(points))
+    }
+
+    /// A spectrum for emission or intensity (any non-negative values).
+    pub(super) fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+        self.spectrum_as(field, s, Role::Emission)
+    }
+
+    /// A spectrum in a role; the role decides what `Rgb` means.
+    fn spectrum_as(&self, field: &str, s: &SpectrumDesc, role: Role) -> Result<Spectrum> {
+        let out = match s {
+            SpectrumDesc::Constant(v) => Spectrum::splat(*v),
+            SpectrumDesc::Samples(v) => {
+                if v.len() != N_BINS {
+                    return Err(
+                        self.err(field, format!("expected 36 samples (380 to 730 nm every 10 nm), found {}", v.len()))
+                    );
+                }
+                Spectrum::from_fn(|i| v[i])
+            }
+            SpectrumDesc::ColorChecker(name) => color::color_checker(name).ok_or_else(|| {
+                self.err(
+                    field,
+                    format!(
+                        "unknown ColorChecker patch \"{name}\"; expected one of: {}",
+                        color::COLOR_CHECKER_NAMES.join(", ")
+                    ),
+                )
+            })?,
+            SpectrumDesc::D65 => color::d65(),
+            SpectrumDesc::EqualEnergy => color::equal_energy(),
+            SpectrumDesc::Blackbody(t) => color::blackbody(*t)
+                .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
+            SpectrumDesc::Scaled(k, inner) => self.spectrum_as(field, inner, role)? * *k,
+            SpectrumDesc::Table(points) => self.table(field, points)?,
+            SpectrumDesc::File(rel) => {
+                let (path, text) = self.read_text_input(field, rel)?;
+                let points = parse_spectrum_file(&text).map_err(|e| Error::Scene {
+                    path: path.clone(),
+                    position: Some((e.line, e.col)),
+                    field: field.to_string(),
+                    message: e.message,
+                })?;
+                self.table(field, &points).map_err(|e| match e {
+                    Error::Scene { field, message, .. } => {
+                        Error::Scene { path: path.clone(), position: None, field, message }
+                    }
+                    e => e,
+                })?
+            }
+            SpectrumDesc::Rgb(r, g, b) => {
+                let rgb = [*r, *g, *b];
+                let limit = if role == Role::Reflectance { 1.0 } else { MAX_MAGNITUDE };
+                if !rgb.iter().all(|v| v.is_finite() && (0.0..=limit).contains(v)) {
+                    return Err(
+                        self.err(field, format!("expected linear sRGB components in [0, {limit}], found {rgb:?}"))
+                    );
+                }
+                match role {
+                    Role::Reflectance => color::rgb_reflectance(rgb),
+                    Role::Emission => color::rgb_emission(rgb),
+                }
+            }
+            SpectrumDesc::Luminance(y, inner) => {
+                let s = self.spectrum_as(field, inner, role)?;
+                let have = s.to_xyz().y;
+                if !(y.is_finite() && *y >= 0.0 && *y <= MAX_MAGNITUDE) {
+                    return Err(self.err(field, format!("expected a luminance in [0, {MAX_MAGNITUDE:e}], found {y}")));
+                }
+                if !(have > 0.0 && have.is_finite()) {
+                    return Err(self.err(field, format!("cannot scale a spectrum of luminance {have} to {y}")));
+                }
+                s * (*y / have)
+            }
+        };
+        if out.has_nan_or_inf() || out.min_value() < 0.0 || out.max_value() > MAX_MAGNITUDE {
+            return Err(self.err(field, format!("expected finite, non-negative values up to {MAX_MAGNITUDE:e}")));
+        }
+        Ok(out)
+    }
+
+    pub(super) fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+        let r = self.spectrum_as(field, s, Role::Reflectance)?;
+        if r.max_value() > 1.0 {
+            return Err(self.err(field, format!("a reflectance must lie in [0, 1], found {}", r.max_value())));
+        }
+        Ok(r)
+    }
+
+    pub(super) fn ior(&self, field: &str, d: &IorDesc) -> Result<Ior> {
+        let ior = match d {
+            IorDesc::Constant(n) => Ior::Constant(*n),
+            IorDesc::Cauchy { a, b } => Ior::Cauchy { a: *a, b: *b },
+            IorDesc::Sellmeier { b, c } => Ior::Sellmeier { b: [b[0], b[1], b[2], 0.0], c: [c[0], c[1], c[2], 0.0] },
+            IorDesc::Named(name) => named_glass(name).ok_or_else(|| {
+                let names: Vec<&str> = NAMED_GLASSES.iter().map(|g| g.0).collect();
+                self.err(field, format!("unknown glass \"{name}\"; expected one of: {}", names.join(", ")))
+            })?,
+        };
+        for lambda in [color::LAMBDA_MIN_NM, 550.0, color::bin_lambda_nm(N_BINS - 1)] {
+            let n = ior.at(lambda);
+            if !(n.is_finite() && n > 0.0) {
+                return Err(self
+                    .err(field, format!("the index of refraction at {lambda} nm is {n}; expected a positive number")));
+            }
+        }
+        Ok(ior)
+    }
+}
