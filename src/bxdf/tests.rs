@@ -159,6 +159,29 @@ pub(super) fn expected_counts_sub(pdf: impl Fn(Vec3) -> f32, n: usize, sub: usiz
     out
 }
 
+/// The histogram over cells of `n` directions sampled from `b` at `wo` for
+/// the single wavelength `l`, with sampler seed `seed`; a sample for which
+/// `keep` is false is not counted (`keep` may also assert on it).
+pub(super) fn sampled_counts(
+    b: &Bxdf,
+    wo: Vec3,
+    l: &Lambdas<1>,
+    n: usize,
+    seed: u64,
+    keep: impl Fn(&BsdfSample<1>) -> bool,
+) -> Vec<f64> {
+    let mut s = Sampler::new(seed, 11, 13);
+    let mut observed = vec![0.0; THETA_RES * PHI_RES];
+    for _ in 0..n {
+        if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), l)
+            && keep(&bs)
+        {
+            observed[cell(bs.wi)] += 1.0;
+        }
+    }
+    observed
+}
+
 /// The cell of a direction.
 pub(super) fn cell(w: Vec3) -> usize {
     let z = w.z.clamp(-1.0, 1.0) as f64;
@@ -233,14 +256,10 @@ fn chi_square_sample_matches_pdf() {
             for bin in wavelength_bins {
                 seed += 1;
                 let l = Lambdas::<1> { pos: [bin as f32], weight: 36.0, readout: crate::spectral::Readout::Spectral };
-                let mut s = Sampler::new(seed, 11, 13);
-                let mut observed = vec![0.0; THETA_RES * PHI_RES];
-                for _ in 0..n {
-                    if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l) {
-                        assert!(!bs.is_delta && bs.pdf > 0.0);
-                        observed[cell(bs.wi)] += 1.0;
-                    }
-                }
+                let observed = sampled_counts(b, wo, &l, n, seed, |bs| {
+                    assert!(!bs.is_delta && bs.pdf > 0.0);
+                    true
+                });
                 let p = chi2_test(&observed, &expected);
                 assert!(p > alpha, "{name}, θo = {theta}°, bin {bin}: p = {p:e} < {alpha:e}");
             }

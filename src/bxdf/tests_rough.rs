@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use super::microfacet::SMOOTH_ALPHA;
 use super::test_util::check_sample_consistency;
-use super::tests::{PHI_RES, THETA_RES, cell, chi2_test, conductor, dir, expected_counts_sub, rough_glass};
+use super::tests::{chi2_test, conductor, dir, expected_counts_sub, rough_glass, sampled_counts};
 use super::*;
 use crate::color::{N_BINS, Spectrum};
 use crate::sampler::Sampler;
@@ -37,14 +37,10 @@ fn chi_square_rough_conductor() {
             let expected = expected_counts_sub(|wi| b.pdf(wo, wi, &Lambdas::full()), n, 48);
             seed += 1;
             let l = Lambdas::<1> { pos: [20.0], weight: 36.0, readout: crate::spectral::Readout::Spectral };
-            let mut s = Sampler::new(seed, 11, 13);
-            let mut observed = vec![0.0; THETA_RES * PHI_RES];
-            for _ in 0..n {
-                if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l) {
-                    assert!(!bs.is_delta && bs.pdf > 0.0 && bs.wi.z * wo.z > 0.0);
-                    observed[cell(bs.wi)] += 1.0;
-                }
-            }
+            let observed = sampled_counts(&b, wo, &l, n, seed, |bs| {
+                assert!(!bs.is_delta && bs.pdf > 0.0 && bs.wi.z * wo.z > 0.0);
+                true
+            });
             let p = chi2_test(&observed, &expected);
             assert!(p > sig, "GGX α {alpha}, θo = {theta}°: p = {p:e} < {sig:e}");
         }
@@ -176,14 +172,10 @@ fn chi_square_rough_dielectric() {
             let wo = Vec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos()).normalize();
             let expected = expected_counts_sub(|wi| b.pdf(wo, wi, &l), n, 48);
             seed += 1;
-            let mut s = Sampler::new(seed, 11, 13);
-            let mut observed = vec![0.0; THETA_RES * PHI_RES];
-            for _ in 0..n {
-                if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l) {
-                    assert!(!bs.is_delta && bs.pdf > 0.0);
-                    observed[cell(bs.wi)] += 1.0;
-                }
-            }
+            let observed = sampled_counts(&b, wo, &l, n, seed, |bs| {
+                assert!(!bs.is_delta && bs.pdf > 0.0);
+                true
+            });
             let p = chi2_test(&observed, &expected);
             assert!(p > sig, "rough glass α {alpha} η {eta}, θo = {theta}°: p = {p:e} < {sig:e}");
         }
@@ -300,15 +292,7 @@ fn chi_square_plastic() {
             let wo = Vec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos()).normalize();
             let expected = expected_counts_sub(|wi| b.pdf(wo, wi, &l), n, 48);
             seed += 1;
-            let mut s = Sampler::new(seed, 11, 13);
-            let mut observed = vec![0.0; THETA_RES * PHI_RES];
-            for _ in 0..n {
-                if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l)
-                    && !bs.is_delta
-                {
-                    observed[cell(bs.wi)] += 1.0;
-                }
-            }
+            let observed = sampled_counts(b, wo, &l, n, seed, |bs| !bs.is_delta);
             let p = chi2_test(&observed, &expected);
             assert!(p > sig, "plastic {b:?}, θo = {theta}°: p = {p:e} < {sig:e}");
         }

@@ -29,11 +29,18 @@ impl PointLight {
     /// The direction to the light from `p`, with the `1/d²` falloff as `scale`.
     #[inline]
     pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
-        let d = self.position - p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        Some(LightSample { wi: d / d2.sqrt(), point: self.position, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
+        toward(self.position, p)
     }
+}
+
+/// The delta sample of a light at `position` seen from `p`: the unit
+/// direction and `1/d²` as `scale` (spot lights multiply in their falloff).
+#[inline]
+pub(super) fn toward(position: Vec3, p: Vec3) -> Option<LightSample> {
+    let d = position - p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    Some(LightSample { wi: d / d2.sqrt(), point: position, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
 }

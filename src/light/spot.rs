@@ -11,6 +11,7 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 use super::LightSample;
+use super::point::toward;
 use crate::color::Spectrum;
 
 /// A spot light at `position` pointing along `axis`.
@@ -62,17 +63,13 @@ impl SpotLight {
     /// The direction to the light from `p`, with falloff and `1/d²` as `scale`.
     #[inline]
     pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
-        let d = self.position - p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = d / d2.sqrt();
-        let f = self.falloff(-wi);
+        let mut ls = toward(self.position, p)?;
+        let f = self.falloff(-ls.wi);
         if f <= 0.0 {
             return None;
         }
-        Some(LightSample { wi, point: self.position, pdf: 1.0, scale: f / d2, is_delta: true })
+        ls.scale *= f;
+        Some(ls)
     }
 }
 
