@@ -64,6 +64,47 @@ impl Camera {
         let dir = (self.right * sx + self.up * sy + self.forward).normalize();
         Ray::new(self.eye, dir)
     }
+
+    /// The viewing direction (unit).
+    #[inline]
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+
+    /// The film position (pixel units) that the unit direction `dir` from
+    /// the eye passes through, if it lies on the film: the inverse of
+    /// [`Camera::ray`].
+    #[inline]
+    pub fn project(&self, dir: Vec3) -> Option<Vec2> {
+        let z = dir.dot(self.forward);
+        if !(z > 0.0) {
+            return None;
+        }
+        let sx = dir.dot(self.right) / z;
+        let sy = dir.dot(self.up) / z;
+        let fx = (sx / self.tan_half_x + 1.0) * 0.5 * self.width as f32;
+        let fy = (1.0 - sy / self.tan_half_y) * 0.5 * self.height as f32;
+        (fx >= 0.0 && fx < self.width as f32 && fy >= 0.0 && fy < self.height as f32).then_some(Vec2::new(fx, fy))
+    }
+
+    /// The area of the whole film on the image plane at distance 1 from the eye.
+    #[inline]
+    pub fn plane_area(&self) -> f32 {
+        4.0 * self.tan_half_x * self.tan_half_y
+    }
+
+    /// The density per unit solid angle of the camera ray directions over
+    /// the whole film (one ray per pixel, uniform on the film): `1 / (A cos³θ)`
+    /// with `A` the [`Camera::plane_area`], for directions that reach the film
+    /// (0 otherwise). Importance `W_e = 1 / (A cos⁴θ)` is this over `cos θ`.
+    #[inline]
+    pub fn pdf_dir(&self, dir: Vec3) -> f32 {
+        if self.project(dir).is_none() {
+            return 0.0;
+        }
+        let cos = dir.dot(self.forward);
+        1.0 / (self.plane_area() * cos * cos * cos)
+    }
 }
 
 #[cfg(test)]
@@ -84,6 +125,33 @@ mod tests {
         // Row 0 is the top of the image.
         assert!(cam.ray(Vec2::new(128.0, 0.0)).dir.y > 0.0);
         assert!(cam.ray(Vec2::new(0.0, 128.0)).dir.x < 0.0);
+    }
+
+    /// `project` inverts `ray` over the film, and refuses directions off it
+    /// or behind the eye; the direction density integrates to 1 over the
+    /// film (a midpoint sum over a fine grid of film positions, with the
+    /// Jacobian dω = cos³θ dA of the image plane at distance 1).
+    #[test]
+    fn project_inverts_ray_and_the_density_integrates_to_one() {
+        let cam = Camera::new(Vec3::new(0.3, 1.0, 3.0), Vec3::new(0.0, 0.8, 0.0), Vec3::Y, 40.0, 64, 48);
+        for (x, y) in [(0.5f32, 0.5f32), (63.9, 0.1), (10.25, 47.75), (32.0, 24.0)] {
+            let p = cam.project(cam.ray(Vec2::new(x, y)).dir).unwrap();
+            assert!((p - Vec2::new(x, y)).length() < 2e-3, "{x},{y} -> {p}");
+        }
+        assert!(cam.project(-cam.forward()).is_none());
+        assert!(cam.project(cam.ray(Vec2::new(-0.5, 3.0)).dir).is_none());
+        let n = 400;
+        let mut integral = 0.0f64;
+        let da = cam.plane_area() as f64 / (n * n) as f64;
+        for i in 0..n {
+            for j in 0..n {
+                let f = Vec2::new((i as f32 + 0.5) * 64.0 / n as f32, (j as f32 + 0.5) * 48.0 / n as f32);
+                let d = cam.ray(f).dir;
+                let cos = d.dot(cam.forward()) as f64;
+                integral += cam.pdf_dir(d) as f64 * cos * cos * cos * da;
+            }
+        }
+        assert!((integral - 1.0).abs() < 1e-4, "{integral}");
     }
 
     #[test]

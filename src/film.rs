@@ -90,6 +90,18 @@ pub(crate) fn from_fixed(v: i128) -> f64 {
     v as f64 / SCALE
 }
 
+/// A contribution that lands in a pixel other than its camera sample's: a
+/// light subpath connected to the camera (light tracing, BDPT's t = 1).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Splat<S> {
+    /// Column.
+    pub x: u32,
+    /// Row.
+    pub y: u32,
+    /// The contribution, already divided by the light subpaths per pass.
+    pub value: S,
+}
+
 /// A rectangle of pixels `[x0, x1) × [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Tile {
@@ -357,6 +369,39 @@ impl Film {
                 .map(|(band, (rows, spec))| add_band(band, rows, Some(spec)))
                 .sum(),
         }
+    }
+
+    /// Adds splats to their pixels. Like samples, they are summed in fixed
+    /// point, so the result does not depend on the order of the splats or of
+    /// the calls; non-finite ones are dropped and counted, oversized ones
+    /// clamped and counted (the return value).
+    pub(crate) fn add_splats<S: FilmSample>(&mut self, splats: &[Splat<S>]) -> usize {
+        let mut bad = 0;
+        for s in splats {
+            let v = s.value.xyz();
+            let bins = s.value.bins();
+            if !(v.x.is_finite() && v.y.is_finite() && v.z.is_finite()) || bins.is_some_and(|b| b.has_nan_or_inf()) {
+                bad += 1;
+                continue;
+            }
+            if s.x >= self.width || s.y >= self.height {
+                continue;
+            }
+            let k = s.y as usize * self.width as usize + s.x as usize;
+            if v.x.abs().max(v.y.abs()).max(v.z.abs()) > MAX_SAMPLE {
+                bad += 1;
+            }
+            if let (Some(spec), Some(b)) = (self.spectral.as_mut(), bins) {
+                for (acc, &x) in spec[k].iter_mut().zip(&b.0) {
+                    *acc += to_fixed(x);
+                }
+            }
+            let sum = &mut self.sums[k];
+            sum[0] += to_fixed(v.x);
+            sum[1] += to_fixed(v.y);
+            sum[2] += to_fixed(v.z);
+        }
+        bad
     }
 
     /// Adds the passes of `other`, which must be the same size and hold the

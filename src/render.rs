@@ -30,7 +30,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use crate::color::{Spectrum, Xyz};
-use crate::film::{Film, FilmSample, Tile, tiles};
+use crate::film::{Film, FilmSample, Splat, Tile, tiles};
 use crate::integrator::{Estimator, EstimatorFn, with_estimator};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
@@ -109,7 +109,7 @@ pub fn render(
     limits: Limits<'_>,
     on_pass: &mut dyn FnMut(&Film, &Progress),
 ) -> RenderStats {
-    with_estimator(&scene.settings, Run { scene, film, passes, limits, on_pass })
+    with_estimator(scene, Run { scene, film, passes, limits, on_pass })
 }
 
 struct Run<'a, 'b> {
@@ -154,7 +154,7 @@ impl Run<'_, '_> {
                 break;
             }
             let k = batch.min(passes.end - next);
-            let results: Vec<Option<Vec<O>>> = (0..k as usize * tiles.len())
+            let results: Vec<Option<TileSamples<O>>> = (0..k as usize * tiles.len())
                 .into_par_iter()
                 .map(|task| {
                     if limits.stop.load(Ordering::Relaxed) {
@@ -171,10 +171,13 @@ impl Run<'_, '_> {
             } else {
                 results.chunks(tiles.len()).take_while(|p| p.iter().all(Option::is_some)).count()
             };
-            let samples: Vec<Vec<O>> = results.into_iter().take(whole * tiles.len()).flatten().collect();
+            let (samples, splats): (Vec<Vec<O>>, Vec<Vec<Splat<O>>>) =
+                results.into_iter().take(whole * tiles.len()).flatten().unzip();
             if whole > 0 {
                 if !tiles.is_empty() {
                     stats.invalid_samples += film.add_tiles_parallel(&tiles, &samples, TILE_SIZE) as u64;
+                    // Integer sums: the order in which splats are added does not matter.
+                    stats.invalid_samples += splats.iter().map(|s| film.add_splats(s)).sum::<usize>() as u64;
                 }
                 for _ in 0..whole {
                     film.end_pass();
@@ -200,6 +203,9 @@ impl Run<'_, '_> {
     }
 }
 
+/// A tile's samples (one per pixel, row-major) and the splats its light subpaths made.
+type TileSamples<O> = (Vec<O>, Vec<Splat<O>>);
+
 /// One sample for every pixel of `tile` in pass `pass`.
 fn render_tile<E: Estimator, O: Contribution>(
     scene: &Scene,
@@ -207,17 +213,18 @@ fn render_tile<E: Estimator, O: Contribution>(
     width: u32,
     tile: &Tile,
     pass: u32,
-) -> Vec<O> {
+) -> TileSamples<O> {
     let seed = scene.settings.seed;
     let mut out = Vec::with_capacity(tile.len());
+    let mut splats = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             let pixel = y as u64 * width as u64 + x as u64;
             let mut sampler = Sampler::new(seed, pixel, pass as u64);
             let jitter = sampler.next_2d();
             let film_pos = Vec2::new(x as f32, y as f32) + jitter;
-            out.push(estimator.sample(scene, film_pos, &mut sampler));
+            out.push(estimator.sample(scene, film_pos, &mut sampler, &mut splats));
         }
     }
-    out
+    (out, splats)
 }

@@ -73,7 +73,7 @@ macro_rules! named_enum {
 named_enum! {
     /// The light-transport methods ([`crate::integrator`]).
     IntegratorKind {
-        /// The default: full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
+        /// The default: picks `bdpt` when a delta light meets a specular surface (caustics path tracing cannot find), else path tracing with the full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
         Auto = "auto",
         /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
         Path = "path",
@@ -81,6 +81,10 @@ named_enum! {
         Whitted = "whitted",
         /// Spectral path tracing with wavelength packets that split at dispersive surfaces.
         Spectral = "spectral",
+        /// Bidirectional path tracing: every connection of a camera and a light subpath, combined by MIS.
+        Bdpt = "bdpt",
+        /// Light tracing alone: light subpaths connected to the camera.
+        LightTrace = "lighttrace",
     }
 }
 
@@ -311,7 +315,8 @@ mod tests {
         for k in WavelengthsKind::ALL {
             assert_eq!(WavelengthsKind::from_name(k.name()), Some(*k));
         }
-        assert_eq!(IntegratorKind::from_name("bdpt"), None);
+        assert_eq!(IntegratorKind::from_name("bdpt"), Some(IntegratorKind::Bdpt));
+        assert_eq!(IntegratorKind::from_name("BDPT"), None);
     }
 
     #[test]

@@ -19,29 +19,34 @@
 //! direct lighting. A path of `k` bounces has `k + 1` segments, so Mitsuba's
 //! `max_depth = k + 1`. The NEE shadow ray from the `k`-th bounce is allowed.
 
+mod bdpt;
 mod path;
 mod whitted;
 
+pub use bdpt::Bdpt;
 pub use path::PathTracer;
 pub use whitted::Whitted;
 
 use glam::{Vec2, Vec3};
 
 use crate::bxdf::Bxdf;
+use crate::film::Splat;
 use crate::color::Sampled;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::Scene;
-use crate::settings::{IntegratorKind, Settings, WavelengthsKind};
+use crate::settings::{IntegratorKind, WavelengthsKind};
 use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet};
 
 /// Computes the colour of one camera sample. Implementations are chosen once
 /// per render and the render loop is generic over them.
 pub(crate) trait Estimator: Sync {
     /// The estimate of one sample through film position `film` (pixel units): its XYZ, or its
-    /// per-bin radiance for spectral output.
-    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O;
+    /// per-bin radiance for spectral output. Light subpaths connected to the camera land in
+    /// whatever pixel they reach: those contributions go to `splats`.
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, splats: &mut Vec<Splat<O>>)
+    -> O;
 }
 
 /// The light-transport method, with its bounce limit.
@@ -75,7 +80,7 @@ pub(crate) struct FullSpectrum(pub Transport);
 
 impl Estimator for FullSpectrum {
     #[inline]
-    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O {
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
         let ray = scene.camera.ray(film);
         self.0.li(scene, ray, &Lambdas::full(), sampler)
     }
@@ -86,7 +91,7 @@ pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling)
 
 impl<const C: usize> Estimator for Packets<C> {
     #[inline]
-    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O {
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
         let ray = scene.camera.ray(film);
         let u: [f32; C] = std::array::from_fn(|_| sampler.next_1d());
         self.0.li(scene, ray, &sample_packet::<C>(self.1, u), sampler)
@@ -98,7 +103,7 @@ pub(crate) struct RgbWavelengths(pub Transport);
 
 impl Estimator for RgbWavelengths {
     #[inline]
-    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler) -> O {
+    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
         let ray = scene.camera.ray(film);
         self.0.li(scene, ray, &Lambdas::rgb(), sampler)
     }
@@ -106,13 +111,18 @@ impl Estimator for RgbWavelengths {
 
 /// Calls `f` with the estimator the settings ask for: the one place where the
 /// integrator is chosen, outside the tile loop.
-pub(crate) fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> R {
+pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
+    let settings = &scene.settings;
+    let bdpt = |light_only| Bdpt { max_bounces: settings.max_bounces, light_only };
     let whitted = Transport::Whitted(Whitted { max_bounces: settings.max_bounces });
     let path = |disperse| {
         Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
     };
     match settings.integrator {
+        IntegratorKind::Auto if needs_bdpt(scene) => f.call(&bdpt(false)),
         IntegratorKind::Auto => f.call(&FullSpectrum(path(true))),
+        IntegratorKind::Bdpt => f.call(&bdpt(false)),
+        IntegratorKind::LightTrace => f.call(&bdpt(true)),
         IntegratorKind::Whitted => f.call(&FullSpectrum(whitted)),
         IntegratorKind::Path => f.call(&FullSpectrum(path(false))),
         IntegratorKind::Spectral => {
@@ -131,12 +141,25 @@ pub(crate) fn with_estimator<R>(settings: &Settings, f: impl EstimatorFn<R>) -> 
     }
 }
 
+/// True when the scene has light that path tracing cannot reach well: a
+/// delta light (point, spot, distant, beam) together with a specular
+/// surface (smooth glass, mirror, smooth metal, thin sheet), whose caustics
+/// no camera path can connect to the light. `auto` then picks `bdpt`.
+pub fn needs_bdpt(scene: &Scene) -> bool {
+    let delta_light = scene.lights.iter().any(|l| l.is_delta());
+    delta_light && scene.objects.iter().any(|o| scene.materials[o.material as usize].is_delta())
+}
+
 /// One line saying which light-transport model the settings pick for this
 /// scene and why (printed once by `rust-v render`).
 pub fn describe(scene: &Scene) -> String {
     let s = &scene.settings;
     let dispersive = scene.has_dispersion();
     match s.integrator {
+        IntegratorKind::Auto if needs_bdpt(scene) => format!(
+            "auto: a point, spot, distant or beam light meets a specular surface (caustics path tracing cannot find): bidirectional path tracing{}",
+            if dispersive { "; the full spectrum until a subpath refracts at dispersive glass, then one wavelength" } else { ", full spectrum" }
+        ),
         IntegratorKind::Auto if dispersive => format!(
             "auto: dispersive material present: full-spectrum path tracing; a path that refracts at dispersive glass continues as {} single wavelengths drawn by throughput and visual importance",
             s.packet_size
@@ -144,6 +167,8 @@ pub fn describe(scene: &Scene) -> String {
         IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),
         IntegratorKind::Path if dispersive => "path: full spectrum; dispersive glass refracts every wavelength like 589.3 nm (no rainbow)".into(),
         IntegratorKind::Path => "path: full-spectrum path tracing".into(),
+        IntegratorKind::Bdpt => "bdpt: bidirectional path tracing, every strategy combined by MIS (power heuristic)".into(),
+        IntegratorKind::LightTrace => "lighttrace: light subpaths connected to the camera only (no camera paths)".into(),
         IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
         IntegratorKind::Spectral => match s.wavelengths {
             WavelengthsKind::Rgb => "spectral, rgb: three wavelengths (435.8, 546.1, 700 nm) read out as RGB".into(),

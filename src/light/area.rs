@@ -132,14 +132,26 @@ impl AreaLight {
         if self.two_sided { wi.dot(n).abs() } else { -wi.dot(n) }
     }
 
-    /// Samples a point uniformly by area; the pdf is per solid angle from `p`.
+    /// A point uniformly by area and its geometric normal.
     #[inline]
-    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+    pub(super) fn sample_point(&self, u: Vec2) -> (Vec3, Vec3) {
         // Choose a patch with u.x, then reuse u.x's position within its interval.
         let k = self.cdf.partition_point(|&c| c <= u.x).min(self.patches.len() - 1);
         let lo = if k == 0 { 0.0 } else { self.cdf[k - 1] };
         let ux = ((u.x - lo) / (self.cdf[k] - lo)).clamp(0.0, 1.0 - f32::EPSILON);
-        let (point, n) = self.patches[k].sample(Vec2::new(ux, u.y));
+        self.patches[k].sample(Vec2::new(ux, u.y))
+    }
+
+    /// The total area of the emitting surface.
+    #[inline]
+    pub(super) fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// Samples a point uniformly by area; the pdf is per solid angle from `p`.
+    #[inline]
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let (point, n) = self.sample_point(u);
         let d = point - p;
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -150,7 +162,7 @@ impl AreaLight {
         if cos_l <= 0.0 {
             return None;
         }
-        Some(LightSample { wi, point, pdf: d2 / (cos_l * self.area), scale: 1.0, is_delta: false })
+        Some(LightSample { wi, point, n, pdf: d2 / (cos_l * self.area), scale: 1.0, is_delta: false })
     }
 
     /// The pdf per solid angle of [`AreaLight::sample_li`] from `p` for `wi`

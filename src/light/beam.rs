@@ -47,7 +47,7 @@ impl BeamLight {
             return None;
         }
         let point = self.origin + off_axis;
-        Some(LightSample { wi: -self.direction, point, pdf: 1.0, scale: 1.0, is_delta: true })
+        Some(LightSample { wi: -self.direction, point, n: self.direction, pdf: 1.0, scale: 1.0, is_delta: true })
     }
 }
 

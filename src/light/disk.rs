@@ -51,7 +51,7 @@ impl DiskLight {
             return None; // the back of a one-sided light
         }
         let area = PI * disk.radius * disk.radius;
-        Some(LightSample { wi, point, pdf: d2 / (cos_l * area), scale: 1.0, is_delta: false })
+        Some(LightSample { wi, point, n: disk.normal, pdf: d2 / (cos_l * area), scale: 1.0, is_delta: false })
     }
 
     /// The pdf per solid angle of [`DiskLight::sample_li`] from `p` for `wi` hitting `point`.

@@ -23,6 +23,8 @@ pub struct DistantLight {
     /// Radius of a sphere around the scene's bounded objects and camera
     /// (set by the scene): shadow rays are this long, twice over.
     pub scene_radius: f32,
+    /// The centre of that sphere (where light tracing starts its rays).
+    pub scene_center: Vec3,
 }
 
 impl DistantLight {
@@ -37,6 +39,6 @@ impl DistantLight {
     pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
         let wi = -self.direction;
         let point = p + wi * (2.0 * self.scene_radius);
-        Some(LightSample { wi, point, pdf: 1.0, scale: 1.0, is_delta: true })
+        Some(LightSample { wi, point, n: self.direction, pdf: 1.0, scale: 1.0, is_delta: true })
     }
 }

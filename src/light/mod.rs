@@ -25,6 +25,7 @@ mod area;
 mod beam;
 mod disk;
 mod distant;
+mod emit;
 mod point;
 mod sphere;
 mod spot;
@@ -33,6 +34,7 @@ pub use area::AreaLight;
 pub use beam::BeamLight;
 pub use disk::DiskLight;
 pub use distant::DistantLight;
+pub use emit::EmissionSample;
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use spot::SpotLight;
@@ -67,6 +69,9 @@ pub struct LightSample {
     pub wi: Vec3,
     /// The sampled point on the light.
     pub point: Vec3,
+    /// The light's surface normal at `point` (zero for point and spot
+    /// lights; the emission direction for distant lights and beams).
+    pub n: Vec3,
     /// The pdf of `wi` per unit solid angle (1 for delta lights).
     pub pdf: f32,
     /// Scale to apply to the light's spectrum: 1 for area lights, distant
@@ -134,10 +139,11 @@ impl Light {
     }
 
     /// Tells lights that depend on the scene's size (distant lights) the
-    /// radius of a sphere around everything bounded and the camera.
-    pub fn set_scene_radius(&mut self, radius: f32) {
+    /// centre and radius of a sphere around everything bounded and the camera.
+    pub fn set_scene_bounds(&mut self, center: Vec3, radius: f32) {
         if let Light::Distant(l) = self {
             l.scene_radius = radius;
+            l.scene_center = center;
         }
     }
 

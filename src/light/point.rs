@@ -42,5 +42,5 @@ pub(super) fn toward(position: Vec3, p: Vec3) -> Option<LightSample> {
     if d2 == 0.0 {
         return None;
     }
-    Some(LightSample { wi: d / d2.sqrt(), point: position, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
+    Some(LightSample { wi: d / d2.sqrt(), point: position, n: Vec3::ZERO, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
 }

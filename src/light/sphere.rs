@@ -58,7 +58,7 @@ impl SphereLight {
                 return None;
             }
             let pdf = dist2 / (cos_l * 4.0 * PI * r2);
-            return Some(LightSample { wi, point, pdf, scale: 1.0, is_delta: false });
+            return Some(LightSample { wi, point, n, pdf, scale: 1.0, is_delta: false });
         }
         let d = d2.sqrt();
         let one_minus_cos_max = cone_one_minus_cos(r2 / d2);
@@ -77,7 +77,8 @@ impl SphereLight {
         let dist = d * cos_t - (r2 - d2 * sin2_t).max(0.0).sqrt();
         let point = p + wi * dist;
         let pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
-        Some(LightSample { wi, point, pdf, scale: 1.0, is_delta: false })
+        let n = (point - sphere.center) / sphere.radius;
+        Some(LightSample { wi, point, n, pdf, scale: 1.0, is_delta: false })
     }
 
     /// The pdf per solid angle of [`SphereLight::sample_li`] from `p` for `wi` hitting `point`.

@@ -454,6 +454,7 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Sc
                 direction: ctx.direction(&format!("lights[{i}].direction"), *direction)?,
                 irradiance: ctx.spectrum(&format!("lights[{i}].irradiance"), irradiance)?,
                 scene_radius: 1.0,
+                scene_center: glam::Vec3::ZERO,
             })),
             LightDesc::Beam { origin, direction, radius, irradiance } => lights.push(Light::Beam(BeamLight {
                 origin: ctx.vec(&format!("lights[{i}].origin"), *origin)?,

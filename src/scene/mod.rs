@@ -104,7 +104,7 @@ impl Scene {
         let world = bounds.iter().fold(Aabb::new(camera.eye(), camera.eye()), |a, b| a.union(b));
         let radius = (world.diagonal().length() * 0.5).max(1.0);
         for l in &mut lights {
-            l.set_scene_radius(radius);
+            l.set_scene_bounds(world.centroid(), radius);
         }
         let bvh = (bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);

@@ -1,0 +1,755 @@
+//! Bidirectional path tracing (`--integrator bdpt`) and light tracing
+//! (`--integrator lighttrace`), spectral (Veach 1997 ch. 10; pbrt-v4 §13.4
+//! describes the same bookkeeping: read, not copied).
+//!
+//! # Data flow of one camera sample
+//! 1. One uniform number `u_λ` is drawn first (see *Wavelengths*).
+//! 2. The **camera subpath** `x0 … x_{t-1}`: `x0` is the eye, `x1` the first
+//!    hit of the pixel's ray, then BSDF sampling (radiance transport) up to
+//!    `max_bounces + 1` surface vertices, Russian roulette after
+//!    [`RR_DEPTH`] bounces. Each vertex keeps its throughput `β`, the area
+//!    density `pdf_fwd` with which this walk generated it, and `pdf_rev`,
+//!    the density with which a walk in the opposite direction would have.
+//! 3. The **light subpath** `y0 … y_{s-1}`: a light chosen by power, a ray
+//!    from [`Light::sample_le`], then BSDF sampling in importance transport
+//!    (the adjoint BSDF: refraction is not scaled by `1/η²`, and shading
+//!    normals get Veach's correction `|ωo·ns||ωi·ng| / (|ωo·ng||ωi·ns|)`),
+//!    up to `max_bounces` surface vertices.
+//! 4. **Every strategy** `(s, t)` with `s + t − 2 ≤ max_bounces` connects the
+//!    prefixes: `s = 0` is the camera subpath hitting an emitter; `s = 1` is
+//!    next-event estimation (a fresh light sample, as the path tracer's);
+//!    `t = 1` connects a light vertex to the eye and is **splatted** to the
+//!    pixel it projects to; the others join `y_{s-1}` and `x_{t-1}` with a
+//!    shadow ray. Delta vertices (mirror, smooth glass, point and spot
+//!    light positions, distant and beam directions) cannot be connection
+//!    ends; their strategies get weight 0 and the others share their paths.
+//! 5. Each strategy's contribution is weighted by the **power heuristic**
+//!    over all strategies that could have made the same path,
+//!    `w_s = p_s² / Σ_i p_i²`, computed from the ratios `pdf_rev / pdf_fwd`
+//!    along the path (a zero density of a delta vertex counts as 1 in the
+//!    ratios and its strategies are skipped, as in Veach's thesis §10.3.5).
+//!    `lighttrace` uses only `t = 1`, unweighted.
+//!
+//! A camera sample's own value is the sum of its `t ≥ 2` strategies; its
+//! `t = 1` splats go to the film's fixed-point sums wherever they land
+//! (see [`crate::film::Splat`]). Each pass traces one light subpath per
+//! pixel, so a splat is divided by the number of pixels: that is the
+//! `1/A` in the camera importance `W_e = 1/(A cos⁴θ)`, `A` the whole film's
+//! area on the plane at distance 1 (`Camera::pdf_dir`). Since a pass's light
+//! subpaths are keyed like its camera samples, `(seed, pixel, pass)`, and
+//! integer sums do not depend on order, images stay bit-identical for any
+//! thread count, and `--passes`, resume and merge stay exact.
+//!
+//! # Wavelengths
+//! Both subpaths carry the full 36-bin spectrum. Sampling a direction at a
+//! dispersive surface needs one wavelength, so there the sample **collapses**
+//! to one bin `b`, drawn once per camera sample from the fixed distribution
+//! `p(b) ∝` visual importance ([`bin_importance`]) by `u_λ`: whichever
+//! subpath meets dispersion first, both use the same `b`, so their
+//! wavelengths agree at every connection. The dispersive BSDF is sampled at
+//! `b` and its value is zero in every other bin, so the subpath's throughput
+//! from there on is masked to `b`. A connection whose prefixes include a
+//! collapse (or whose end vertex is rough dispersive glass, evaluated at `b`)
+//! contributes `c(b)/p(b)` in bin `b` only.
+//!
+//! *Unbiased:* `b` is independent of everything before the collapse and
+//! `p(b) > 0` for every bin, so `E_b[c(b) e_b / p(b)] = Σ_b c(b) e_b`, the full
+//! spectrum, for every strategy on its own; connections whose prefixes never
+//! met dispersion are full-spectrum and need no such weight. The MIS weights
+//! use the same densities in every strategy (the reference-wavelength BSDF
+//! pdf at rough dispersive vertices), so they sum to 1 over the strategies of
+//! each path and any such weights keep the sum unbiased. A throughput-driven
+//! draw (as `auto`'s) could not be shared between two independent subpaths;
+//! the fixed draw costs colour noise only where dispersion is.
+//!
+//! # Limits (documented, not silent)
+//! - A shadow ray or connection inside an absorbing dielectric is
+//!   attenuated when one of its end vertices lies on that dielectric; a
+//!   connection between two points inside it that are on other objects is not.
+//! - Every surface assumes vacuum on its outside (no medium stack).
+
+use std::cell::RefCell;
+use std::sync::LazyLock;
+
+use glam::{Vec2, Vec3};
+
+use crate::bxdf::Bxdf;
+use crate::color::Spectrum;
+use crate::film::Splat;
+use crate::geometry::{Frame, Ray};
+use crate::light::Light;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance};
+
+use super::path::RR_DEPTH;
+use super::{Estimator, Shading};
+
+/// Bidirectional path tracing, or light tracing alone.
+#[derive(Clone, Copy, Debug)]
+pub struct Bdpt {
+    /// Maximum number of scattering events on a full path.
+    pub max_bounces: u32,
+    /// Only the `t = 1` strategies, unweighted (`lighttrace`).
+    pub light_only: bool,
+}
+
+/// What a subpath vertex is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// The eye.
+    Camera,
+    /// A point on light `index`.
+    Light(u32),
+    /// A surface point of object `index`.
+    Surface(u32),
+}
+
+/// A subpath vertex.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    kind: Kind,
+    /// Position, geometric normal, shading frame and the local direction
+    /// back along the subpath (`wo`).
+    sh: Shading,
+    /// Throughput of the subpath up to and including this vertex's arrival.
+    beta: Spectrum,
+    /// The scattering sampled here was a delta lobe.
+    delta: bool,
+    /// The subpath collapsed to one wavelength before reaching this vertex.
+    collapsed: bool,
+    /// Area density of this vertex as its own walk generated it.
+    pdf_fwd: f32,
+    /// Area density of this vertex as a walk from the other end would.
+    pdf_rev: f32,
+}
+
+impl Vertex {
+    fn at_point(kind: Kind, p: Vec3, n: Vec3, beta: Spectrum, pdf_fwd: f32) -> Vertex {
+        let frame = Frame::from_z(if n == Vec3::ZERO { Vec3::Z } else { n });
+        let sh = Shading { p, n, frame, wo: Vec3::Z, wo_n: 0.0 };
+        Vertex { kind, sh, beta, delta: false, collapsed: false, pdf_fwd, pdf_rev: 0.0 }
+    }
+
+    #[inline]
+    fn p(&self) -> Vec3 {
+        self.sh.p
+    }
+
+    /// True when densities arriving at this vertex carry its cosine (area
+    /// measure on a surface): surfaces and area lights, not the eye or a
+    /// point, spot, distant or beam light.
+    #[inline]
+    fn on_surface(&self, scene: &Scene) -> bool {
+        match self.kind {
+            Kind::Surface(_) => true,
+            Kind::Light(i) => !scene.lights[i as usize].is_delta(),
+            Kind::Camera => false,
+        }
+    }
+}
+
+/// The one bin a sample collapses to, drawn lazily from `u_λ`.
+struct Wavelength {
+    u: f32,
+    bin: Option<(usize, f32)>,
+}
+
+impl Wavelength {
+    /// The bin and `1 / p(bin)`.
+    fn bin(&mut self) -> (usize, f32) {
+        static DIST: LazyLock<BinDistribution> = LazyLock::new(|| {
+            let importance = bin_importance();
+            BinDistribution::new(|b| importance[b]).expect("visual importance is positive")
+        });
+        let u = self.u;
+        *self.bin.get_or_insert_with(|| {
+            let (b, p) = DIST.sample(u);
+            (b, 1.0 / p)
+        })
+    }
+
+    /// `c` itself, or when `single`, `c(b)/p(b)` in bin `b` only.
+    fn finish(&mut self, c: Spectrum, single: bool) -> Spectrum {
+        if !single {
+            return c;
+        }
+        let (b, inv_p) = self.bin();
+        let mut out = Spectrum::ZERO;
+        out[b] = c[b] * inv_p;
+        out
+    }
+}
+
+/// The packet of one bin.
+#[inline]
+fn one_bin(b: usize) -> Lambdas<1> {
+    Lambdas { pos: [b as f32], weight: 1.0, readout: Readout::Spectral }
+}
+
+/// `f(wo, wi)` at a vertex, full-spectrum, or at bin `b` only when `single`
+/// and the material disperses.
+#[inline]
+fn eval(bxdf: &Bxdf, wo: Vec3, wi: Vec3, single: Option<usize>) -> Spectrum {
+    match single {
+        Some(b) if bxdf.is_dispersive() => {
+            let mut f = Spectrum::ZERO;
+            f[b] = bxdf.eval(wo, wi, &one_bin(b))[0];
+            f
+        }
+        _ => bxdf.eval(wo, wi, &Lambdas::full()),
+    }
+}
+
+/// Veach's correction of the adjoint BSDF for shading normals: the factor
+/// by which importance transport differs from radiance transport where the
+/// shading normal is not the geometric one (1 on flat geometry).
+#[inline]
+fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 {
+    let den = sh.wo_n.abs() * wi_local.z.abs();
+    let c = sh.wo.z.abs() * wi.dot(sh.n).abs() / den;
+    if c.is_finite() { c } else { 0.0 }
+}
+
+thread_local! {
+    /// The two subpaths of the current sample, reused (no allocation per sample).
+    static PATHS: RefCell<(Vec<Vertex>, Vec<Vertex>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+}
+
+impl Estimator for Bdpt {
+    fn sample<O: Contribution>(
+        &self,
+        scene: &Scene,
+        film: Vec2,
+        sampler: &mut Sampler,
+        splats: &mut Vec<Splat<O>>,
+    ) -> O {
+        PATHS.with(|paths| {
+            let mut paths = paths.borrow_mut();
+            let (camera, light) = &mut *paths;
+            camera.clear();
+            light.clear();
+            let mut wl = Wavelength { u: sampler.next_1d(), bin: None };
+            let full = Lambdas::full();
+            let mut l = Spectrum::ZERO;
+            if !self.light_only {
+                self.camera_subpath(scene, film, sampler, camera, &mut wl);
+            }
+            self.light_subpath(scene, sampler, light, &mut wl);
+            let max = self.max_bounces as usize;
+            let t_range = if self.light_only { 1..=1 } else { 1..=camera.len() };
+            for t in t_range {
+                for s in 0..=light.len() {
+                    if s + t < 2 || s + t - 2 > max || (t == 1 && s == 0) {
+                        continue;
+                    }
+                    if t == 1 {
+                        if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, &mut wl) {
+                            let value = O::from_packet(&full, &c);
+                            splats.push(Splat { x: pixel.x as u32, y: pixel.y as u32, value });
+                        }
+                    } else if !self.light_only {
+                        l += self.connect(scene, camera, t, light, s, sampler, &mut wl);
+                    }
+                }
+            }
+            O::from_packet(&full, &l)
+        })
+    }
+}
+
+impl Bdpt {
+    /// The eye and the walk of the pixel ray.
+    fn camera_subpath(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, path: &mut Vec<Vertex>, wl: &mut Wavelength) {
+        let cam = &scene.camera;
+        let ray = cam.ray(film);
+        path.push(Vertex::at_point(Kind::Camera, ray.origin, cam.forward(), Spectrum::ONE, 1.0));
+        let pdf_dir = cam.pdf_dir(ray.dir);
+        let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2 };
+        walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, wl);
+    }
+
+    /// A light by power, a ray leaving it, and its walk.
+    fn light_subpath(&self, scene: &Scene, sampler: &mut Sampler, path: &mut Vec<Vertex>, wl: &mut Wavelength) {
+        let u_light = sampler.next_1d();
+        let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+        let Some((index, pmf)) = scene.choose_light(u_light) else {
+            return;
+        };
+        let light = &scene.lights[index];
+        let Some(e) = light.sample_le(u_pos, u_dir) else {
+            return;
+        };
+        let pdf_origin = pmf * e.pdf_pos;
+        if !(pdf_origin > 0.0 && e.pdf_dir > 0.0) {
+            return;
+        }
+        let beta0 = *light.spectrum() / pdf_origin;
+        path.push(Vertex::at_point(Kind::Light(index as u32), e.point, e.n, beta0, pdf_origin));
+        let cos = if light.is_delta() { 1.0 } else { e.dir.dot(e.n).abs() };
+        let beta = beta0 * (e.scale * cos / e.pdf_dir);
+        // A parallel light's next vertex has the density of the ray's origin
+        // on the light's disk, projected (no 1/d²): passed as its "pdf".
+        let (pdf, parallel) = if light.is_delta_direction() { (e.pdf_pos, true) } else { (e.pdf_dir, false) };
+        let ray = Ray::spawn(e.point, e.n, e.dir);
+        let walk = Walk { importance: true, max_vertices: self.max_bounces as usize + 1 };
+        walk.run(scene, ray, beta, pdf, parallel, sampler, path, wl);
+    }
+
+    /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye. Returns
+    /// the film position and the MIS-weighted contribution.
+    fn connect_camera(
+        &self,
+        scene: &Scene,
+        light: &[Vertex],
+        s: usize,
+        camera: &[Vertex],
+        wl: &mut Wavelength,
+    ) -> Option<(Vec2, Spectrum)> {
+        let qs = &light[s - 1];
+        if qs.delta {
+            return None;
+        }
+        let cam = &scene.camera;
+        let eye = cam.eye();
+        let to_eye = eye - qs.p();
+        let d2 = to_eye.length_squared();
+        if !(d2 > 0.0) {
+            return None;
+        }
+        let w = to_eye / d2.sqrt();
+        let film = cam.project(-w)?;
+        let cos_cam = (-w).dot(cam.forward());
+        // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
+        let single = qs.collapsed || is_dispersive(scene, qs);
+        let f = match qs.kind {
+            Kind::Light(i) => {
+                let light = &scene.lights[i as usize];
+                let e = emit_factor(light, qs.sh.n, w);
+                if e <= 0.0 {
+                    return None;
+                }
+                Spectrum::splat(e)
+            }
+            Kind::Surface(o) => {
+                let bxdf = material(scene, o);
+                let wi = qs.sh.frame.to_local(w);
+                if !qs.sh.consistent(w, wi) {
+                    return None;
+                }
+                let b = if single { Some(wl.bin().0) } else { None };
+                eval(bxdf, wi, qs.sh.wo, b) * (wi.z.abs() * shading_correction(&qs.sh, w, wi))
+            }
+            Kind::Camera => return None,
+        };
+        let c = qs.beta * f * (1.0 / (d2 * cam.plane_area() * cos_cam * cos_cam * cos_cam));
+        if c.is_black() {
+            return None;
+        }
+        let (shadow, t_max) = Ray::spawn_to(qs.p(), qs.sh.n, eye);
+        if scene.occluded(&shadow, t_max) {
+            return None;
+        }
+        let c = c * attenuation(scene, qs, eye);
+        let weight = if self.light_only {
+            1.0
+        } else {
+            let eye_v = &camera[0];
+            let qs_rev = to_area(scene, cam.pdf_dir(-w), eye_v, qs);
+            let qsm_rev = if s >= 2 { pdf_vertex(scene, qs, eye, &light[s - 2]) } else { 0.0 };
+            mis_weight(scene, camera, 1, light, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
+        };
+        Some((film, wl.finish(c * weight, single)))
+    }
+
+    /// Strategies `(s, t ≥ 2)`: emitter hit (`s = 0`), next-event estimation
+    /// (`s = 1`), or a connection of `x_{t-1}` and `y_{s-1}`; MIS-weighted.
+    #[allow(clippy::too_many_arguments)]
+    fn connect(
+        &self,
+        scene: &Scene,
+        camera: &[Vertex],
+        t: usize,
+        light: &[Vertex],
+        s: usize,
+        sampler: &mut Sampler,
+        wl: &mut Wavelength,
+    ) -> Spectrum {
+        let pt = &camera[t - 1];
+        let Kind::Surface(object) = pt.kind else {
+            return Spectrum::ZERO;
+        };
+        let ptm = &camera[t - 2];
+        match s {
+            0 => {
+                // The camera subpath ends on an emitter.
+                let Some(index) = scene.objects[object as usize].light else {
+                    return Spectrum::ZERO;
+                };
+                let light = &scene.lights[index as usize];
+                let dir = (pt.p() - ptm.p()).normalize();
+                let scale = light.le_scale(pt.sh.n, dir);
+                if scale <= 0.0 {
+                    return Spectrum::ZERO;
+                }
+                let c = pt.beta * *light.spectrum() * scale;
+                let (pdf_pos, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
+                let pt_rev = scene.light_pmf[index as usize] * pdf_pos;
+                let as_light = Vertex { kind: Kind::Light(index), ..*pt };
+                let ptm_rev = to_area(scene, pdf_dir, &as_light, ptm);
+                let weight = mis_weight(
+                    scene,
+                    camera,
+                    t,
+                    light_none(),
+                    0,
+                    Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 },
+                );
+                wl.finish(c * weight, pt.collapsed)
+            }
+            1 => {
+                // Next-event estimation: a fresh point on a light.
+                let (u_light, u) = (sampler.next_1d(), sampler.next_2d());
+                if pt.delta {
+                    return Spectrum::ZERO;
+                }
+                let Some((index, pmf)) = scene.choose_light(u_light) else {
+                    return Spectrum::ZERO;
+                };
+                let light = &scene.lights[index];
+                let Some(ls) = light.sample_li(pt.p(), u) else {
+                    return Spectrum::ZERO;
+                };
+                let wi = pt.sh.frame.to_local(ls.wi);
+                if !pt.sh.consistent(ls.wi, wi) {
+                    return Spectrum::ZERO;
+                }
+                let bxdf = material(scene, object);
+                let single = pt.collapsed || bxdf.is_dispersive();
+                let b = if single { Some(wl.bin().0) } else { None };
+                let f = eval(bxdf, pt.sh.wo, wi, b);
+                if f.is_black() || !(ls.pdf > 0.0) {
+                    return Spectrum::ZERO;
+                }
+                let (shadow, t_max) = Ray::spawn_to(pt.p(), pt.sh.n, ls.point);
+                if scene.occluded(&shadow, t_max) {
+                    return Spectrum::ZERO;
+                }
+                let c = pt.beta * f * *light.spectrum() * (ls.scale * wi.z.abs() / (pmf * ls.pdf));
+                let c = c * attenuation(scene, pt, ls.point);
+                // The sampled light vertex, for the MIS weight.
+                let (pdf_pos, _) = light.pdf_le(ls.n, -ls.wi);
+                let y = Vertex::at_point(Kind::Light(index as u32), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
+                let pt_rev = pdf_light(scene, &y, pt);
+                let ptm_rev = pdf_vertex(scene, pt, ls.point, ptm);
+                let qs_rev = pdf_vertex(scene, pt, ptm.p(), &y);
+                let weight = mis_weight(
+                    scene,
+                    camera,
+                    t,
+                    std::slice::from_ref(&y),
+                    1,
+                    Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 },
+                );
+                wl.finish(c * weight, single)
+            }
+            _ => {
+                let qs = &light[s - 1];
+                if pt.delta || qs.delta {
+                    return Spectrum::ZERO;
+                }
+                let Kind::Surface(q_object) = qs.kind else {
+                    return Spectrum::ZERO;
+                };
+                let d = qs.p() - pt.p();
+                let d2 = d.length_squared();
+                if !(d2 > 0.0) {
+                    return Spectrum::ZERO;
+                }
+                let w = d / d2.sqrt();
+                let (wi_p, wi_q) = (pt.sh.frame.to_local(w), qs.sh.frame.to_local(-w));
+                if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
+                    return Spectrum::ZERO;
+                }
+                let (bp, bq) = (material(scene, object), material(scene, q_object));
+                let single = pt.collapsed || qs.collapsed || bp.is_dispersive() || bq.is_dispersive();
+                let b = if single { Some(wl.bin().0) } else { None };
+                let fp = eval(bp, pt.sh.wo, wi_p, b);
+                let fq = eval(bq, wi_q, qs.sh.wo, b) * shading_correction(&qs.sh, -w, wi_q);
+                let g = wi_p.z.abs() * wi_q.z.abs() / d2;
+                let c = pt.beta * fp * fq * qs.beta * g;
+                if c.is_black() {
+                    return Spectrum::ZERO;
+                }
+                let (shadow, t_max) = Ray::spawn_to(pt.p(), pt.sh.n, qs.p());
+                if scene.occluded(&shadow, t_max) {
+                    return Spectrum::ZERO;
+                }
+                let c = c * attenuation(scene, pt, qs.p());
+                let pt_rev = pdf_vertex(scene, qs, light[s - 2].p(), pt);
+                let ptm_rev = pdf_vertex(scene, pt, qs.p(), ptm);
+                let qs_rev = pdf_vertex(scene, pt, ptm.p(), qs);
+                let qsm_rev = pdf_vertex(scene, qs, pt.p(), &light[s - 2]);
+                let weight =
+                    mis_weight(scene, camera, t, light, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
+                wl.finish(c * weight, single)
+            }
+        }
+    }
+}
+
+/// A subpath walk's fixed parameters.
+struct Walk {
+    /// Importance transport (the light subpath) rather than radiance.
+    importance: bool,
+    /// The most vertices the subpath may have, its first included.
+    max_vertices: usize,
+}
+
+impl Walk {
+    /// Extends `path` along `ray` by BSDF sampling. `pdf_dir` is the density
+    /// of `ray`'s direction at the last vertex (per solid angle; for a
+    /// `parallel` light, per area of its disk).
+    #[allow(clippy::too_many_arguments)]
+    fn run(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        mut beta: Spectrum,
+        mut pdf_dir: f32,
+        mut parallel: bool,
+        sampler: &mut Sampler,
+        path: &mut Vec<Vertex>,
+        wl: &mut Wavelength,
+    ) {
+        let full = Lambdas::full();
+        let beta_ref = beta.max_value();
+        let mut collapsed = false;
+        let mut bounces = 0u32;
+        while path.len() < self.max_vertices {
+            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let hit = si.hit;
+            let bxdf = material(scene, si.object);
+            // Beer-Lambert along a segment inside an absorbing dielectric.
+            if let Some(sigma) = bxdf.absorption()
+                && ray.dir.dot(hit.n) > 0.0
+            {
+                beta *= (*sigma * -hit.t).exp();
+            }
+            let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
+            let prev = *path.last().expect("a subpath starts at the eye or a light");
+            let mut v = Vertex { kind: Kind::Surface(si.object), sh, beta, delta: false, collapsed, pdf_fwd: 0.0, pdf_rev: 0.0 };
+            v.pdf_fwd =
+                if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, &prev, &v) };
+            parallel = false;
+            path.push(v);
+            if path.len() >= self.max_vertices || bxdf.is_black() {
+                break;
+            }
+            let (u, uc) = (sampler.next_2d(), sampler.next_1d());
+            let sample = if bxdf.is_dispersive() {
+                // The direction depends on the wavelength: collapse to the sample's bin.
+                let (b, _) = wl.bin();
+                collapsed = true;
+                bxdf.sample(sh.wo, u, uc, &one_bin(b)).map(|s| {
+                    let mut f = Spectrum::ZERO;
+                    f[b] = s.f[0];
+                    crate::bxdf::BsdfSample { wi: s.wi, f, pdf: s.pdf, is_delta: s.is_delta, eta: s.eta }
+                })
+            } else {
+                bxdf.sample(sh.wo, u, uc, &full)
+            };
+            let Some(bs) = sample else {
+                break;
+            };
+            let wi = sh.frame.to_world(bs.wi);
+            if !sh.consistent(wi, bs.wi) || !(bs.pdf > 0.0) {
+                break;
+            }
+            let mut weight = bs.f * (bs.wi.z.abs() / bs.pdf);
+            if self.importance {
+                // The adjoint BSDF: no 1/η² radiance scaling; Veach's shading-normal correction.
+                weight *= bs.eta * bs.eta * shading_correction(&sh, wi, bs.wi);
+            }
+            beta *= weight;
+            let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf(bs.wi, sh.wo, &full)) };
+            let n = path.len();
+            path[n - 1].delta = bs.is_delta;
+            let (here, before) = (path[n - 1], path[n - 2]);
+            path[n - 2].pdf_rev = to_area(scene, rev, &here, &before);
+            pdf_dir = fwd;
+            if beta.is_black() || beta.has_nan_or_inf() {
+                break;
+            }
+            bounces += 1;
+            if bounces >= RR_DEPTH {
+                let q = (beta.max_value() / beta_ref).min(0.95);
+                if !(sampler.next_1d() < q) {
+                    break;
+                }
+                beta /= q;
+            }
+            ray = Ray::spawn(hit.p, hit.n, wi);
+        }
+    }
+}
+
+/// The material of object `o`.
+#[inline]
+fn material(scene: &Scene, o: u32) -> &Bxdf {
+    &scene.materials[scene.objects[o as usize].material as usize]
+}
+
+/// True when vertex `v` lies on a dispersive surface.
+#[inline]
+fn is_dispersive(scene: &Scene, v: &Vertex) -> bool {
+    matches!(v.kind, Kind::Surface(o) if material(scene, o).is_dispersive())
+}
+
+/// The emitted quantity from light point (normal `n`) towards `w`, as a
+/// factor of the light's spectrum, times the cosine at an area light.
+#[inline]
+fn emit_factor(light: &Light, n: Vec3, w: Vec3) -> f32 {
+    match light {
+        Light::Point(_) => 1.0,
+        Light::Spot(l) => l.falloff(w),
+        Light::Distant(_) | Light::Beam(_) => 0.0,
+        Light::Sphere(_) | Light::Disk(_) | Light::Area(_) => light.le_scale(n, -w) * w.dot(n).abs(),
+    }
+}
+
+/// Beer-Lambert attenuation of a connection from vertex `v` to point `to`
+/// that runs inside `v`'s absorbing dielectric.
+#[inline]
+fn attenuation(scene: &Scene, v: &Vertex, to: Vec3) -> Spectrum {
+    if let Kind::Surface(o) = v.kind
+        && let Some(sigma) = material(scene, o).absorption()
+    {
+        let d = to - v.p();
+        if d.dot(v.sh.n) < 0.0 {
+            return (*sigma * -d.length()).exp();
+        }
+    }
+    Spectrum::ONE
+}
+
+/// Converts a density per solid angle at `from` towards `to` into a density
+/// per unit area at `to`.
+#[inline]
+fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -> f32 {
+    let d = to.p() - from.p();
+    let d2 = d.length_squared();
+    if !(d2 > 0.0) {
+        return 0.0;
+    }
+    let mut pdf = pdf_dir / d2;
+    if to.on_surface(scene) {
+        pdf *= (d.dot(to.sh.n) / d2.sqrt()).abs();
+    }
+    pdf
+}
+
+/// The area density at `next` of a walk that arrived at surface vertex `v`
+/// from point `prev` and sampled its BSDF (0 for delta lobes).
+#[inline]
+fn pdf_vertex(scene: &Scene, v: &Vertex, prev: Vec3, next: &Vertex) -> f32 {
+    match v.kind {
+        Kind::Surface(o) => {
+            let bxdf = material(scene, o);
+            let (wp, wn) = ((prev - v.p()).normalize_or_zero(), (next.p() - v.p()).normalize_or_zero());
+            let (wo, wi) = (v.sh.frame.to_local(wp), v.sh.frame.to_local(wn));
+            to_area(scene, bxdf.pdf(wo, wi, &Lambdas::full()), v, next)
+        }
+        Kind::Light(_) => pdf_light(scene, v, next),
+        Kind::Camera => to_area(scene, scene.camera.pdf_dir((next.p() - v.p()).normalize_or_zero()), v, next),
+    }
+}
+
+/// The area density at `next` of the ray `sample_le` would start from light
+/// vertex `y` towards it.
+#[inline]
+fn pdf_light(scene: &Scene, y: &Vertex, next: &Vertex) -> f32 {
+    let Kind::Light(i) = y.kind else {
+        return 0.0;
+    };
+    let light = &scene.lights[i as usize];
+    let w = (next.p() - y.p()).normalize_or_zero();
+    let (pdf_pos, pdf_dir) = light.pdf_le(y.sh.n, w);
+    if light.is_delta_direction() {
+        // Parallel rays: the disk's density projected onto `next`.
+        let cos = if next.on_surface(scene) { w.dot(next.sh.n).abs() } else { 1.0 };
+        return pdf_pos * cos;
+    }
+    to_area(scene, pdf_dir, y, next)
+}
+
+/// The densities a strategy changes at the connection: `pt_rev` at
+/// `x_{t-1}`, `ptm_rev` at `x_{t-2}`, `qs_rev` at `y_{s-1}`, `qsm_rev` at
+/// `y_{s-2}`.
+#[derive(Clone, Copy, Debug)]
+struct Overrides {
+    pt_rev: f32,
+    ptm_rev: f32,
+    qs_rev: f32,
+    qsm_rev: f32,
+}
+
+/// An empty light subpath.
+#[inline]
+fn light_none() -> &'static [Vertex] {
+    &[]
+}
+
+/// The power-heuristic weight of strategy `(s, t)` for the path made of
+/// `camera[..t]` and `light[..s]`: `1 / (1 + Σ_i (p_i / p_s)²)` over the
+/// other strategies, each ratio a product of `pdf_rev / pdf_fwd` along the
+/// path (zero densities, of delta vertices, count as 1; strategies that
+/// would need a connection at a delta vertex are skipped).
+fn mis_weight(scene: &Scene, camera: &[Vertex], t: usize, light: &[Vertex], s: usize, o: Overrides) -> f32 {
+    let remap = |p: f32| if p > 0.0 { p } else { 1.0 };
+    let mut sum = 0.0f32;
+    // Camera side: x_{t-1} … x_1 generated from the light instead.
+    let cam_rev = |i: usize| {
+        if i + 1 == t {
+            o.pt_rev
+        } else if i + 2 == t {
+            o.ptm_rev
+        } else {
+            camera[i].pdf_rev
+        }
+    };
+    let cam_delta = |i: usize| i + 1 != t && camera[i].delta;
+    let mut ri = 1.0f32;
+    for i in (1..t).rev() {
+        ri *= remap(cam_rev(i)) / remap(camera[i].pdf_fwd);
+        if !cam_delta(i) && !cam_delta(i - 1) {
+            sum += ri * ri;
+        }
+    }
+    // Light side: y_{s-1} … y_0 generated from the camera instead.
+    let light_rev = |i: usize| {
+        if i + 1 == s {
+            o.qs_rev
+        } else if i + 2 == s {
+            o.qsm_rev
+        } else {
+            light[i].pdf_rev
+        }
+    };
+    let light_delta = |i: usize| i + 1 != s && light[i].delta;
+    let delta_light = match light.first().map(|v| v.kind) {
+        Some(Kind::Light(i)) => scene.lights[i as usize].is_delta(),
+        _ => false,
+    };
+    let mut ri = 1.0f32;
+    for i in (0..s).rev() {
+        ri *= remap(light_rev(i)) / remap(light[i].pdf_fwd);
+        let delta_before = if i > 0 { light_delta(i - 1) } else { delta_light };
+        if !light_delta(i) && !delta_before {
+            sum += ri * ri;
+        }
+    }
+    1.0 / (1.0 + sum)
+}

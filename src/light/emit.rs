@@ -1,0 +1,240 @@
+//! Rays leaving the lights: where light tracing and bidirectional path
+//! tracing start their light subpaths.
+//!
+//! [`Light::sample_le`] draws a point on the light and a direction out of it
+//! and returns both densities separately (pbrt-v4 §12's `SampleLe`):
+//!
+//! | light | point | pdf_pos (per area) | direction | pdf_dir (per solid angle) |
+//! |---|---|---|---|---|
+//! | point | the position | 1 (delta) | uniform sphere | 1/4π |
+//! | spot | the position | 1 (delta) | uniform in the cone | 1/(2π(1 − cos θ_cone)) |
+//! | sphere, disk, quad, cuboid, mesh | uniform by area | 1/A | cosine around the emitting side (a two-sided light picks a side with probability ½) | cos θ/π (·½) |
+//! | distant | uniform on a disk of the scene's radius R, upstream of the scene | 1/(πR²) | the light's direction | 1 (delta) |
+//! | beam | uniform on the beam's disk | 1/(πr²) | the beam's direction | 1 (delta) |
+//!
+//! The radiance leaving along the ray is `scale ×` [`Light::spectrum`]; for a
+//! point or spot light the "radiance" is the intensity (the delta in
+//! position is in `pdf_pos`), for distant lights and beams the irradiance
+//! (the delta is in direction). [`Light::pdf_le`] gives both densities for a
+//! ray found otherwise, for the MIS weights of bidirectional path tracing.
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+use super::Light;
+use crate::geometry::Frame;
+use crate::sampler::warp::{concentric_disk, cosine_hemisphere, uniform_sphere};
+
+/// A ray leaving a light.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionSample {
+    /// The point the ray leaves from.
+    pub point: Vec3,
+    /// The light's surface normal there (zero for point and spot lights, the
+    /// direction of travel for distant lights and beams).
+    pub n: Vec3,
+    /// The unit direction of the ray.
+    pub dir: Vec3,
+    /// The density of `point` per unit area (1 for a delta position).
+    pub pdf_pos: f32,
+    /// The density of `dir` per unit solid angle (1 for a delta direction).
+    pub pdf_dir: f32,
+    /// The emitted quantity along the ray as a factor of [`Light::spectrum`].
+    pub scale: f32,
+}
+
+impl Light {
+    /// True for lights at a single point (point and spot lights).
+    #[inline]
+    pub fn is_delta_position(&self) -> bool {
+        matches!(self, Light::Point(_) | Light::Spot(_))
+    }
+
+    /// True for lights whose rays are all parallel (distant lights and beams).
+    #[inline]
+    pub fn is_delta_direction(&self) -> bool {
+        matches!(self, Light::Distant(_) | Light::Beam(_))
+    }
+
+    /// True when no ray can hit the light (every light in the `lights:` list).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        self.is_delta_position() || self.is_delta_direction()
+    }
+
+    /// Samples a ray leaving the light with `u_pos` (the point) and `u_dir`
+    /// (the direction). `None` when the light emits nothing.
+    #[inline]
+    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        match self {
+            Light::Point(l) => Some(EmissionSample {
+                point: l.position,
+                n: Vec3::ZERO,
+                dir: uniform_sphere(u_dir),
+                pdf_pos: 1.0,
+                pdf_dir: 1.0 / (4.0 * PI),
+                scale: 1.0,
+            }),
+            Light::Spot(l) => {
+                let one_minus_cos = 1.0 - l.cos_total;
+                if one_minus_cos <= 0.0 {
+                    return None;
+                }
+                let v = u_dir.x * one_minus_cos;
+                let cos = 1.0 - v;
+                let sin = (v * (2.0 - v)).max(0.0).sqrt();
+                let phi = 2.0 * PI * u_dir.y;
+                let dir = Frame::from_z(l.axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)).normalize();
+                let scale = l.falloff(dir);
+                (scale > 0.0).then_some(EmissionSample {
+                    point: l.position,
+                    n: Vec3::ZERO,
+                    dir,
+                    pdf_pos: 1.0,
+                    pdf_dir: 1.0 / (2.0 * PI * one_minus_cos),
+                    scale,
+                })
+            }
+            Light::Sphere(l) => {
+                let n = uniform_sphere(u_pos);
+                let point = l.sphere.center + n * l.sphere.radius;
+                let area = 4.0 * PI * l.sphere.radius * l.sphere.radius;
+                surface_ray(point, n, area, l.two_sided, u_dir)
+            }
+            Light::Disk(l) => {
+                let q = concentric_disk(u_pos) * l.disk.radius;
+                let point = l.disk.center + Frame::from_z(l.disk.normal).to_world(Vec3::new(q.x, q.y, 0.0));
+                let area = PI * l.disk.radius * l.disk.radius;
+                surface_ray(point, l.disk.normal, area, l.two_sided, u_dir)
+            }
+            Light::Area(l) => {
+                let (point, n) = l.sample_point(u_pos);
+                surface_ray(point, n, l.area(), l.two_sided, u_dir)
+            }
+            Light::Distant(l) => {
+                let r = l.scene_radius;
+                parallel_ray(l.scene_center - l.direction * r, l.direction, r, u_pos)
+            }
+            Light::Beam(l) => parallel_ray(l.origin, l.direction, l.radius, u_pos),
+        }
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` with which [`Light::sample_le`]
+    /// would produce the ray leaving `point` (light normal `n`) along `dir`;
+    /// for delta lights, whose rays no other strategy can produce, the
+    /// non-delta part only.
+    #[inline]
+    pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        match self {
+            Light::Point(_) => (1.0, 1.0 / (4.0 * PI)),
+            Light::Spot(l) => {
+                let inside = dir.dot(l.axis) >= l.cos_total && l.cos_total < 1.0;
+                (1.0, if inside { 1.0 / (2.0 * PI * (1.0 - l.cos_total)) } else { 0.0 })
+            }
+            Light::Sphere(l) => {
+                (1.0 / (4.0 * PI * l.sphere.radius * l.sphere.radius), surface_pdf_dir(n, dir, l.two_sided))
+            }
+            Light::Disk(l) => {
+                (1.0 / (PI * l.disk.radius * l.disk.radius), surface_pdf_dir(n, dir, l.two_sided))
+            }
+            Light::Area(l) => (1.0 / l.area(), surface_pdf_dir(n, dir, l.two_sided)),
+            Light::Distant(l) => (1.0 / (PI * l.scene_radius * l.scene_radius), 1.0),
+            Light::Beam(l) => (1.0 / (PI * l.radius * l.radius), 1.0),
+        }
+    }
+}
+
+/// A cosine-distributed ray from a point of an area light.
+#[inline]
+fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Option<EmissionSample> {
+    if !(area > 0.0) {
+        return None;
+    }
+    let (side, u, pick) = if !two_sided {
+        (n, u, 1.0)
+    } else if u.x < 0.5 {
+        (n, Vec2::new(u.x * 2.0, u.y), 0.5)
+    } else {
+        (-n, Vec2::new((u.x - 0.5) * 2.0, u.y), 0.5)
+    };
+    let local = cosine_hemisphere(Vec2::new(u.x.min(1.0 - f32::EPSILON), u.y));
+    if local.z <= 0.0 {
+        return None;
+    }
+    let dir = Frame::from_z(side).to_world(local).normalize();
+    Some(EmissionSample { point, n, dir, pdf_pos: 1.0 / area, pdf_dir: pick * local.z / PI, scale: 1.0 })
+}
+
+/// The direction density of [`surface_ray`].
+#[inline]
+fn surface_pdf_dir(n: Vec3, dir: Vec3, two_sided: bool) -> f32 {
+    let cos = dir.dot(n);
+    if two_sided {
+        0.5 * cos.abs() / PI
+    } else if cos > 0.0 {
+        cos / PI
+    } else {
+        0.0
+    }
+}
+
+/// A ray of a collimated disk of radius `r` centred at `center`, travelling along `dir`.
+#[inline]
+fn parallel_ray(center: Vec3, dir: Vec3, r: f32, u: Vec2) -> Option<EmissionSample> {
+    if !(r > 0.0) {
+        return None;
+    }
+    let q = concentric_disk(u) * r;
+    let point = center + Frame::from_z(dir).to_world(Vec3::new(q.x, q.y, 0.0));
+    Some(EmissionSample { point, n: dir, dir, pdf_pos: 1.0 / (PI * r * r), pdf_dir: 1.0, scale: 1.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::color::Spectrum;
+    use crate::light::{BeamLight, DiskLight, PointLight, SphereLight, SpotLight};
+    use crate::sampler::Sampler;
+    use crate::shape::{Disk, Sphere};
+
+    /// The emitted power Φ = ∫∫ L cos dA dω is what `sample_le` estimates as
+    /// `scale · |cos| / (pdf_pos · pdf_dir)` (times the spectrum): the mean
+    /// must equal each light's closed-form power (its `power()` divided by
+    /// the spectrum's mean, here 1). 20k samples; the estimate is exactly
+    /// constant for point, disk and beam lights and varies only with the
+    /// falloff for a spot (std. error < 0.5%), so 1%. Also `pdf_le` agrees
+    /// with the densities `sample_le` returned.
+    #[test]
+    fn emitted_power_matches_the_closed_forms() {
+        let lights = [
+            Light::Point(PointLight { position: Vec3::ONE, intensity: Spectrum::ONE }),
+            Light::Spot(SpotLight::new(Vec3::ZERO, Vec3::NEG_Y, 30.0, 10.0, Spectrum::ONE)),
+            Light::Sphere(SphereLight {
+                sphere: Sphere::new(Vec3::ZERO, 0.3),
+                radiance: Spectrum::ONE,
+                two_sided: false,
+            }),
+            Light::Disk(DiskLight {
+                disk: Disk { center: Vec3::Y, normal: Vec3::NEG_Y, radius: 0.5 },
+                radiance: Spectrum::ONE,
+                two_sided: true,
+            }),
+            Light::Beam(BeamLight { origin: Vec3::ZERO, direction: Vec3::X, radius: 0.2, irradiance: Spectrum::ONE }),
+        ];
+        let mut s = Sampler::new(1, 2, 3);
+        for light in &lights {
+            let n = 20_000;
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                let Some(e) = light.sample_le(s.next_2d(), s.next_2d()) else { continue };
+                let cos = if light.is_delta_position() || light.is_delta_direction() { 1.0 } else { e.dir.dot(e.n).abs() };
+                sum += (e.scale * cos / (e.pdf_pos * e.pdf_dir)) as f64;
+                let (pp, pd) = light.pdf_le(e.n, e.dir);
+                assert!((pp - e.pdf_pos).abs() <= 1e-5 * pp && (pd - e.pdf_dir).abs() <= 1e-4 * pd, "{light:?}");
+            }
+            let power = sum / n as f64;
+            let want = light.power() as f64;
+            assert!((power / want - 1.0).abs() < 0.01, "{light:?}: {power} vs {want}");
+        }
+    }
+}
