@@ -6,6 +6,7 @@
 mod common;
 
 mod auto;
+mod bdpt;
 mod checkpoint;
 mod cli;
 mod furnace;

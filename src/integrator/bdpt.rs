@@ -325,6 +325,11 @@ impl Bdpt {
         let f = match qs.kind {
             Kind::Light(i) => {
                 let light = &scene.lights[i as usize];
+                if light.is_delta() {
+                    // Point and spot lights are invisible to the camera in every
+                    // integrator (path tracing cannot see them either).
+                    return None;
+                }
                 let e = emit_factor(light, qs.sh.n, w);
                 if e <= 0.0 {
                     return None;
