@@ -11,13 +11,14 @@ use rust_v::film::Film;
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 mod glass;
+mod lighttrace;
 mod materials;
 mod surfaces;
 
 use crate::common::{mean_and_stderr, render_str, temp_dir};
 
-/// The five methods of the failure matrix.
-const METHODS: [&str; 5] = ["whitted", "path", "hero", "random", "auto"];
+/// The methods of the failure matrix that must give every answer (light tracing has its own tests: `lighttrace.rs`).
+const METHODS: [&str; 6] = ["whitted", "path", "hero", "random", "auto", "bdpt"];
 
 fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
     let (integrator, wavelengths) = match m {
@@ -26,6 +27,8 @@ fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
         "hero" => (IntegratorKind::Spectral, Some(WavelengthsKind::Hero)),
         "random" => (IntegratorKind::Spectral, Some(WavelengthsKind::Random)),
         "auto" => (IntegratorKind::Auto, None),
+        "bdpt" => (IntegratorKind::Bdpt, None),
+        "lighttrace" => (IntegratorKind::LightTrace, None),
         _ => unreachable!(),
     };
     SettingsPatch { integrator: Some(integrator), wavelengths, spp: Some(spp), seed: Some(seed), ..Default::default() }
@@ -34,7 +37,7 @@ fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
 /// Full-spectrum methods give every sample the same colour for a grey
 /// scene; the packet samplers (hero, random) add colour noise with the right mean.
 fn full_spectrum(m: &str) -> bool {
-    matches!(m, "whitted" | "path" | "auto")
+    matches!(m, "whitted" | "path" | "auto" | "bdpt" | "lighttrace")
 }
 
 /// Relative per-pixel tolerance where every path of a full-spectrum method
