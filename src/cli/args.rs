@@ -61,7 +61,7 @@ pub struct ConvergeArgs {
     /// The render size defaults to the reference's.
     #[arg(long)]
     pub reference: PathBuf,
-    /// Methods, comma-separated: auto, path, hero, random, whitted, rgb.
+    /// Methods, comma-separated: auto, path, hero, random, whitted, rgb, bdpt, lighttrace.
     #[arg(long, value_delimiter = ',', default_value = "path,hero,random")]
     pub methods: Vec<String>,
     /// Render each method with this many seeds (the scene's seed, +1, +2, ...) to show the spread.

@@ -307,7 +307,7 @@ impl Bdpt {
         wl: &mut Wavelength,
     ) -> Option<(Vec2, Spectrum)> {
         let qs = &light[s - 1];
-        if qs.delta {
+        if !connectible(scene, qs) {
             return None;
         }
         let cam = &scene.camera;
@@ -415,7 +415,7 @@ impl Bdpt {
             1 => {
                 // Next-event estimation: a fresh point on a light.
                 let (u_light, u) = (sampler.next_1d(), sampler.next_2d());
-                if pt.delta {
+                if !connectible(scene, pt) {
                     return Spectrum::ZERO;
                 }
                 let Some((index, pmf)) = scene.choose_light(u_light) else {
@@ -460,7 +460,7 @@ impl Bdpt {
             }
             _ => {
                 let qs = &light[s - 1];
-                if pt.delta || qs.delta {
+                if !connectible(scene, pt) || !connectible(scene, qs) {
                     return Spectrum::ZERO;
                 }
                 let Kind::Surface(q_object) = qs.kind else {
@@ -605,6 +605,18 @@ impl Walk {
 #[inline]
 fn material(scene: &Scene, o: u32) -> &Bxdf {
     &scene.materials[scene.objects[o as usize].material as usize]
+}
+
+/// True when a connection can end at `v`: a surface whose material has a
+/// non-delta part (a plastic whose walk sampled its mirror coat still has
+/// its diffuse base), or a light. Not the sampled lobe's `delta` flag,
+/// which only says how the walk continued.
+#[inline]
+fn connectible(scene: &Scene, v: &Vertex) -> bool {
+    match v.kind {
+        Kind::Surface(o) => !material(scene, o).is_delta(),
+        Kind::Light(_) | Kind::Camera => true,
+    }
 }
 
 /// True when vertex `v` lies on a dispersive surface.

@@ -45,6 +45,8 @@ pub const METHODS: &[Method] = &[
     Method { name: "random", integrator: IntegratorKind::Spectral, wavelengths: Some(WavelengthsKind::Random) },
     Method { name: "whitted", integrator: IntegratorKind::Whitted, wavelengths: None },
     Method { name: "rgb", integrator: IntegratorKind::Spectral, wavelengths: Some(WavelengthsKind::Rgb) },
+    Method { name: "bdpt", integrator: IntegratorKind::Bdpt, wavelengths: None },
+    Method { name: "lighttrace", integrator: IntegratorKind::LightTrace, wavelengths: None },
 ];
 
 impl Method {
