@@ -74,7 +74,7 @@ use std::sync::LazyLock;
 use glam::{Vec2, Vec3};
 
 use crate::bxdf::Bxdf;
-use crate::color::Spectrum;
+use crate::color::{Sampled, Spectrum};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
 use crate::light::Light;
@@ -149,56 +149,49 @@ impl Vertex {
     }
 }
 
-/// The one bin a sample collapses to, drawn lazily from `u_λ`.
+/// The one wavelength a sample collapses to, drawn lazily from `u_λ`.
 struct Wavelength {
     u: f32,
-    bin: Option<(usize, f32)>,
+    drawn: Option<Single>,
+}
+
+/// The collapsed wavelength: the slot of a throughput that holds its value,
+/// and the packet of one wavelength (with the weight `1/p`) that evaluates
+/// materials at it and reads its value out as colour.
+#[derive(Clone, Copy, Debug)]
+struct Single {
+    slot: usize,
+    lambdas: Lambdas<1>,
 }
 
 impl Wavelength {
-    /// The bin and `1 / p(bin)`.
-    fn bin(&mut self) -> (usize, f32) {
+    /// The sample's wavelength (drawn on first use).
+    fn single(&mut self) -> Single {
         static DIST: LazyLock<BinDistribution> = LazyLock::new(|| {
             let importance = bin_importance();
             BinDistribution::new(|b| importance[b]).expect("visual importance is positive")
         });
         let u = self.u;
-        *self.bin.get_or_insert_with(|| {
+        *self.drawn.get_or_insert_with(|| {
             let (b, p) = DIST.sample(u);
-            (b, 1.0 / p)
+            Single { slot: b, lambdas: Lambdas { pos: [b as f32], weight: 1.0 / p, readout: Readout::Spectral } }
         })
     }
 
-    /// `c` itself, or when `single`, `c(b)/p(b)` in bin `b` only.
-    fn finish(&mut self, c: Spectrum, single: bool) -> Spectrum {
-        if !single {
-            return c;
-        }
-        let (b, inv_p) = self.bin();
-        let mut out = Spectrum::ZERO;
-        out[b] = c[b] * inv_p;
-        out
+    /// The value of throughput `v` at the sample's wavelength: the slot that
+    /// holds it once its subpath has collapsed, else its interpolation there.
+    fn at(&mut self, v: &Spectrum, collapsed: bool) -> f32 {
+        let one = self.single();
+        if collapsed { v[one.slot] } else { one.lambdas.sample(v)[0] }
     }
 }
 
-/// The packet of one bin.
-#[inline]
-fn one_bin(b: usize) -> Lambdas<1> {
-    Lambdas { pos: [b as f32], weight: 1.0, readout: Readout::Spectral }
-}
-
-/// `f(wo, wi)` at a vertex, full-spectrum, or at bin `b` only when `single`
-/// and the material disperses.
-#[inline]
-fn eval(bxdf: &Bxdf, wo: Vec3, wi: Vec3, single: Option<usize>) -> Spectrum {
-    match single {
-        Some(b) if bxdf.is_dispersive() => {
-            let mut f = Spectrum::ZERO;
-            f[b] = bxdf.eval(wo, wi, &one_bin(b))[0];
-            f
-        }
-        _ => bxdf.eval(wo, wi, &Lambdas::full()),
-    }
+/// A strategy's contribution: the full spectrum, or one value at the
+/// sample's collapsed wavelength.
+#[derive(Clone, Copy, Debug)]
+enum Contrib {
+    Full(Spectrum),
+    Single(f32),
 }
 
 /// Veach's correction of the adjoint BSDF for shading normals: the factor
@@ -229,9 +222,9 @@ impl Estimator for Bdpt {
             let (camera, light) = &mut *paths;
             camera.clear();
             light.clear();
-            let mut wl = Wavelength { u: sampler.next_1d(), bin: None };
+            let mut wl = Wavelength { u: sampler.next_1d(), drawn: None };
             let full = Lambdas::full();
-            let mut l = Spectrum::ZERO;
+            let (mut l, mut l_single) = (Spectrum::ZERO, 0.0f32);
             if !self.light_only {
                 self.camera_subpath(scene, film, sampler, camera, &mut wl);
             }
@@ -245,15 +238,25 @@ impl Estimator for Bdpt {
                     }
                     if t == 1 {
                         if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, &mut wl) {
-                            let value = O::from_packet(&full, &c);
+                            let value = match c {
+                                Contrib::Full(c) => O::from_packet(&full, &c),
+                                Contrib::Single(v) => O::from_packet(&wl.single().lambdas, &Sampled([v])),
+                            };
                             splats.push(Splat { x: pixel.x as u32, y: pixel.y as u32, value });
                         }
                     } else if !self.light_only {
-                        l += self.connect(scene, camera, t, light, s, sampler, &mut wl);
+                        match self.connect(scene, camera, t, light, s, sampler, &mut wl) {
+                            Contrib::Full(c) => l += c,
+                            Contrib::Single(v) => l_single += v,
+                        }
                     }
                 }
             }
-            O::from_packet(&full, &l)
+            let mut out = O::from_packet(&full, &l);
+            if let Some(one) = wl.drawn {
+                out += O::from_packet(&one.lambdas, &Sampled([l_single]));
+            }
+            out
         })
     }
 }
@@ -305,7 +308,7 @@ impl Bdpt {
         s: usize,
         camera: &[Vertex],
         wl: &mut Wavelength,
-    ) -> Option<(Vec2, Spectrum)> {
+    ) -> Option<(Vec2, Contrib)> {
         let qs = &light[s - 1];
         if !connectible(scene, qs) {
             return None;
@@ -320,9 +323,10 @@ impl Bdpt {
         let w = to_eye / d2.sqrt();
         let film = cam.project(-w)?;
         let cos_cam = (-w).dot(cam.forward());
-        // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
+        let importance = 1.0 / (d2 * cam.plane_area() * cos_cam * cos_cam * cos_cam);
         let single = qs.collapsed || is_dispersive(scene, qs);
-        let f = match qs.kind {
+        // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
+        let c = match qs.kind {
             Kind::Light(i) => {
                 let light = &scene.lights[i as usize];
                 if light.is_delta() {
@@ -330,11 +334,11 @@ impl Bdpt {
                     // integrator (path tracing cannot see them either).
                     return None;
                 }
-                let e = emit_factor(light, qs.sh.n, w);
-                if e <= 0.0 {
+                let e = emit_factor(light, qs.sh.n, w) * importance;
+                if !(e > 0.0) {
                     return None;
                 }
-                Spectrum::splat(e)
+                if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
             }
             Kind::Surface(o) => {
                 let bxdf = material(scene, o);
@@ -342,20 +346,24 @@ impl Bdpt {
                 if !qs.sh.consistent(w, wi) {
                     return None;
                 }
-                let b = if single { Some(wl.bin().0) } else { None };
-                eval(bxdf, wi, qs.sh.wo, b) * (wi.z.abs() * shading_correction(&qs.sh, w, wi))
+                let k = wi.z.abs() * shading_correction(&qs.sh, w, wi) * importance;
+                if single {
+                    let one = wl.single();
+                    let f = bxdf.eval(wi, qs.sh.wo, &one.lambdas)[0];
+                    Contrib::Single(wl.at(&qs.beta, qs.collapsed) * f * k)
+                } else {
+                    Contrib::Full(qs.beta * bxdf.eval(wi, qs.sh.wo, &Lambdas::full()) * k)
+                }
             }
             Kind::Camera => return None,
         };
-        let c = qs.beta * f * (1.0 / (d2 * cam.plane_area() * cos_cam * cos_cam * cos_cam));
-        if c.is_black() {
+        if is_black(&c) {
             return None;
         }
         let (shadow, t_max) = Ray::spawn_to(qs.p(), qs.sh.n, eye);
         if scene.occluded(&shadow, t_max) {
             return None;
         }
-        let c = c * attenuation(scene, qs, eye);
         let weight = if self.light_only {
             1.0
         } else {
@@ -364,7 +372,7 @@ impl Bdpt {
             let qsm_rev = if s >= 2 { pdf_vertex(scene, qs, eye, &light[s - 2]) } else { 0.0 };
             mis_weight(scene, camera, 1, light, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
         };
-        Some((film, wl.finish(c * weight, single)))
+        Some((film, scale(c, weight, attenuation(scene, qs, eye), wl)))
     }
 
     /// Strategies `(s, t ≥ 2)`: emitter hit (`s = 0`), next-event estimation
@@ -379,127 +387,144 @@ impl Bdpt {
         s: usize,
         sampler: &mut Sampler,
         wl: &mut Wavelength,
-    ) -> Spectrum {
+    ) -> Contrib {
+        const NONE: Contrib = Contrib::Full(Spectrum::ZERO);
         let pt = &camera[t - 1];
         let Kind::Surface(object) = pt.kind else {
-            return Spectrum::ZERO;
+            return NONE;
         };
         let ptm = &camera[t - 2];
         match s {
             0 => {
                 // The camera subpath ends on an emitter.
                 let Some(index) = scene.objects[object as usize].light else {
-                    return Spectrum::ZERO;
+                    return NONE;
                 };
                 let light = &scene.lights[index as usize];
                 let dir = (pt.p() - ptm.p()).normalize();
-                let scale = light.le_scale(pt.sh.n, dir);
-                if scale <= 0.0 {
-                    return Spectrum::ZERO;
+                let le = light.le_scale(pt.sh.n, dir);
+                if le <= 0.0 {
+                    return NONE;
                 }
-                let c = pt.beta * *light.spectrum() * scale;
+                let c = if pt.collapsed {
+                    let one = wl.single();
+                    Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(light.spectrum())[0] * le)
+                } else {
+                    Contrib::Full(pt.beta * *light.spectrum() * le)
+                };
                 let (pdf_pos, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
                 let pt_rev = scene.light_pmf[index as usize] * pdf_pos;
                 let as_light = Vertex { kind: Kind::Light(index), ..*pt };
                 let ptm_rev = to_area(scene, pdf_dir, &as_light, ptm);
-                let weight = mis_weight(
-                    scene,
-                    camera,
-                    t,
-                    light_none(),
-                    0,
-                    Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 },
-                );
-                wl.finish(c * weight, pt.collapsed)
+                let overrides = Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 };
+                scale(c, mis_weight(scene, camera, t, &[], 0, overrides), Spectrum::ONE, wl)
             }
             1 => {
                 // Next-event estimation: a fresh point on a light.
                 let (u_light, u) = (sampler.next_1d(), sampler.next_2d());
                 if !connectible(scene, pt) {
-                    return Spectrum::ZERO;
+                    return NONE;
                 }
                 let Some((index, pmf)) = scene.choose_light(u_light) else {
-                    return Spectrum::ZERO;
+                    return NONE;
                 };
                 let light = &scene.lights[index];
                 let Some(ls) = light.sample_li(pt.p(), u) else {
-                    return Spectrum::ZERO;
+                    return NONE;
                 };
                 let wi = pt.sh.frame.to_local(ls.wi);
-                if !pt.sh.consistent(ls.wi, wi) {
-                    return Spectrum::ZERO;
+                if !pt.sh.consistent(ls.wi, wi) || !(ls.pdf > 0.0) {
+                    return NONE;
                 }
                 let bxdf = material(scene, object);
-                let single = pt.collapsed || bxdf.is_dispersive();
-                let b = if single { Some(wl.bin().0) } else { None };
-                let f = eval(bxdf, pt.sh.wo, wi, b);
-                if f.is_black() || !(ls.pdf > 0.0) {
-                    return Spectrum::ZERO;
+                let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
+                let c = if pt.collapsed || bxdf.is_dispersive() {
+                    let one = wl.single();
+                    let f = bxdf.eval(pt.sh.wo, wi, &one.lambdas)[0];
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(light.spectrum())[0] * k)
+                } else {
+                    Contrib::Full(pt.beta * bxdf.eval(pt.sh.wo, wi, &Lambdas::full()) * *light.spectrum() * k)
+                };
+                if is_black(&c) {
+                    return NONE;
                 }
                 let (shadow, t_max) = Ray::spawn_to(pt.p(), pt.sh.n, ls.point);
                 if scene.occluded(&shadow, t_max) {
-                    return Spectrum::ZERO;
+                    return NONE;
                 }
-                let c = pt.beta * f * *light.spectrum() * (ls.scale * wi.z.abs() / (pmf * ls.pdf));
-                let c = c * attenuation(scene, pt, ls.point);
                 // The sampled light vertex, for the MIS weight.
                 let (pdf_pos, _) = light.pdf_le(ls.n, -ls.wi);
                 let y = Vertex::at_point(Kind::Light(index as u32), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
                 let pt_rev = pdf_light(scene, &y, pt);
                 let ptm_rev = pdf_vertex(scene, pt, ls.point, ptm);
                 let qs_rev = pdf_vertex(scene, pt, ptm.p(), &y);
-                let weight = mis_weight(
-                    scene,
-                    camera,
-                    t,
-                    std::slice::from_ref(&y),
-                    1,
-                    Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 },
-                );
-                wl.finish(c * weight, single)
+                let overrides = Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 };
+                let weight = mis_weight(scene, camera, t, std::slice::from_ref(&y), 1, overrides);
+                scale(c, weight, attenuation(scene, pt, ls.point), wl)
             }
             _ => {
                 let qs = &light[s - 1];
                 if !connectible(scene, pt) || !connectible(scene, qs) {
-                    return Spectrum::ZERO;
+                    return NONE;
                 }
                 let Kind::Surface(q_object) = qs.kind else {
-                    return Spectrum::ZERO;
+                    return NONE;
                 };
                 let d = qs.p() - pt.p();
                 let d2 = d.length_squared();
                 if !(d2 > 0.0) {
-                    return Spectrum::ZERO;
+                    return NONE;
                 }
                 let w = d / d2.sqrt();
                 let (wi_p, wi_q) = (pt.sh.frame.to_local(w), qs.sh.frame.to_local(-w));
                 if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
-                    return Spectrum::ZERO;
+                    return NONE;
                 }
                 let (bp, bq) = (material(scene, object), material(scene, q_object));
-                let single = pt.collapsed || qs.collapsed || bp.is_dispersive() || bq.is_dispersive();
-                let b = if single { Some(wl.bin().0) } else { None };
-                let fp = eval(bp, pt.sh.wo, wi_p, b);
-                let fq = eval(bq, wi_q, qs.sh.wo, b) * shading_correction(&qs.sh, -w, wi_q);
-                let g = wi_p.z.abs() * wi_q.z.abs() / d2;
-                let c = pt.beta * fp * fq * qs.beta * g;
-                if c.is_black() {
-                    return Spectrum::ZERO;
+                let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
+                let c = if pt.collapsed || qs.collapsed || bp.is_dispersive() || bq.is_dispersive() {
+                    let one = wl.single();
+                    let fp = bp.eval(pt.sh.wo, wi_p, &one.lambdas)[0];
+                    let fq = bq.eval(wi_q, qs.sh.wo, &one.lambdas)[0];
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
+                } else {
+                    let full = Lambdas::full();
+                    Contrib::Full(pt.beta * bp.eval(pt.sh.wo, wi_p, &full) * bq.eval(wi_q, qs.sh.wo, &full) * qs.beta * k)
+                };
+                if is_black(&c) {
+                    return NONE;
                 }
                 let (shadow, t_max) = Ray::spawn_to(pt.p(), pt.sh.n, qs.p());
                 if scene.occluded(&shadow, t_max) {
-                    return Spectrum::ZERO;
+                    return NONE;
                 }
-                let c = c * attenuation(scene, pt, qs.p());
                 let pt_rev = pdf_vertex(scene, qs, light[s - 2].p(), pt);
                 let ptm_rev = pdf_vertex(scene, pt, qs.p(), ptm);
                 let qs_rev = pdf_vertex(scene, pt, ptm.p(), qs);
                 let qsm_rev = pdf_vertex(scene, qs, pt.p(), &light[s - 2]);
                 let weight =
                     mis_weight(scene, camera, t, light, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
-                wl.finish(c * weight, single)
+                scale(c, weight, attenuation(scene, pt, qs.p()), wl)
             }
         }
+    }
+}
+
+/// True when a contribution is zero (or not a number: dropped like zero).
+#[inline]
+fn is_black(c: &Contrib) -> bool {
+    match c {
+        Contrib::Full(s) => s.is_black() || s.has_nan_or_inf(),
+        Contrib::Single(v) => !(v.abs() > 0.0 && v.is_finite()),
+    }
+}
+
+/// A contribution times the MIS weight and a segment's transmittance.
+#[inline]
+fn scale(c: Contrib, weight: f32, transmittance: Spectrum, wl: &mut Wavelength) -> Contrib {
+    match c {
+        Contrib::Full(s) => Contrib::Full(s * transmittance * weight),
+        Contrib::Single(v) => Contrib::Single(v * wl.at(&transmittance, false) * weight),
     }
 }
 
@@ -541,7 +566,12 @@ impl Walk {
             if let Some(sigma) = bxdf.absorption()
                 && ray.dir.dot(hit.n) > 0.0
             {
-                beta *= (*sigma * -hit.t).exp();
+                if collapsed {
+                    let one = wl.single();
+                    beta[one.slot] *= (-one.lambdas.sample(sigma)[0] * hit.t).exp();
+                } else {
+                    beta *= (*sigma * -hit.t).exp();
+                }
             }
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             let prev = *path.last().expect("a subpath starts at the eye or a light");
@@ -554,13 +584,19 @@ impl Walk {
                 break;
             }
             let (u, uc) = (sampler.next_2d(), sampler.next_1d());
-            let sample = if bxdf.is_dispersive() {
-                // The direction depends on the wavelength: collapse to the sample's bin.
-                let (b, _) = wl.bin();
-                collapsed = true;
-                bxdf.sample(sh.wo, u, uc, &one_bin(b)).map(|s| {
+            let sample = if collapsed || bxdf.is_dispersive() {
+                let one = wl.single();
+                if !collapsed {
+                    // The direction depends on the wavelength: the subpath collapses to the
+                    // sample's wavelength; its throughput's value there moves to the slot.
+                    let v = one.lambdas.sample(&beta)[0];
+                    beta = Spectrum::ZERO;
+                    beta[one.slot] = v;
+                    collapsed = true;
+                }
+                bxdf.sample(sh.wo, u, uc, &one.lambdas).map(|s| {
                     let mut f = Spectrum::ZERO;
-                    f[b] = s.f[0];
+                    f[one.slot] = s.f[0];
                     crate::bxdf::BsdfSample { wi: s.wi, f, pdf: s.pdf, is_delta: s.is_delta, eta: s.eta }
                 })
             } else {
@@ -711,12 +747,6 @@ struct Overrides {
     ptm_rev: f32,
     qs_rev: f32,
     qsm_rev: f32,
-}
-
-/// An empty light subpath.
-#[inline]
-fn light_none() -> &'static [Vertex] {
-    &[]
 }
 
 /// The power-heuristic weight of strategy `(s, t)` for the path made of
