@@ -340,6 +340,11 @@ pub struct ObjectDesc {
     /// only the side the normal points to, outward for a sphere).
     #[serde(default)]
     pub two_sided: bool,
+    /// For a dielectric object: which medium wins where its volume overlaps
+    /// another's (default 0; higher wins; nested dielectrics, see
+    /// [`crate::bxdf::medium`]): `priority: 2`.
+    #[serde(default)]
+    pub priority: u32,
 }
 
 /// A light that is not an object.

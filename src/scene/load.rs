@@ -423,7 +423,7 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Sc
                 Some(lights.len() as u32 - 1)
             }
         };
-        objects.push(Object { shape, material, light });
+        objects.push(Object { shape, material, light, priority: o.priority });
     }
     for (i, l) in desc.lights.iter().enumerate() {
         match l {
