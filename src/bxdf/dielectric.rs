@@ -33,7 +33,14 @@
 //! **Coating** (`coating: ThinFilm(thickness_nm:, ior:)`, smooth glass only):
 //! the film's Airy reflectance per wavelength replaces Fresnel's
 //! ([`super::thin_film`]); the film is thin, so the ray refracts as through
-//! the bare interface.
+//! the bare interface. The loader refuses a coating on rough glass: the rough model draws its lobe with, and
+//! evaluates, one Fresnel term per microfacet for the packet's single index
+//! (`rough_dielectric::{eval, pdf, sample}` return a scalar); a film makes the
+//! reflectance a function of wavelength and of the microfacet angle `wo·wm`
+//! (the Airy sum), so `f` would become a per-wavelength spectrum and the pdf of
+//! the lobe choice a packet average that `pdf` (called for MIS with the
+//! light sample) would have to reproduce exactly: a new model with its own
+//! chi-square and furnace tests, not a switch.
 //!
 //! ```ron
 //! "glass": Dielectric(ior: Named("N-BK7")),

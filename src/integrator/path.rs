@@ -139,6 +139,10 @@ impl PathTracer {
             // Nested dielectrics: a false intersection goes straight on.
             let at = interface(scene, &mut w.media, &si, ray.dir);
             if let Interface::Pass = at {
+                // Shadow rays stop at every surface, so light sampling never
+                // reaches past a false intersection: the BSDF sample there
+                // carries the full weight at an emitter beyond (no MIS).
+                w.prev.delta = true;
                 passes += 1;
                 ray = Ray::spawn(hit.p, hit.n, ray.dir);
                 match scene.intersect(&ray, f32::INFINITY) {
