@@ -21,12 +21,12 @@
 //!
 //! # Nested dielectrics
 //! Every path carries a [`MediumStack`] (starting as [`Scene::camera_media`]):
-//! at a dielectric's surface, [`interface`] decides whether the hit is a
+//! at a dielectric's surface, `interface` decides whether the hit is a
 //! false intersection (passed straight through, no bounce counted, no light
 //! sample) or a real interface and what lies outside it; a transmission
-//! updates the stack ([`Interface::scattered`]). Segments, and shadow rays,
-//! are absorbed by the medium they run in ([`Surround`]). A path may pass at
-//! most [`MAX_PASSES`] false intersections in a row (then it ends).
+//! updates the stack (`Interface::scattered`). Segments, and shadow rays,
+//! are absorbed by the medium they run in (`Surround`). A path may pass at
+//! most `MAX_PASSES` (64) false intersections in a row (then it ends).
 
 mod path;
 mod whitted;
