@@ -273,3 +273,38 @@ fn media_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> MediumStac
     }
     stack
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::SettingsPatch;
+
+    fn camera_media(eye: &str, objects: &str) -> Vec<u32> {
+        let text = format!(
+            r#"(camera: (eye: {eye}, look_at: (0.1, 0.2, -3), fov_deg: 30),
+            materials: {{ "glass": Dielectric(ior: Constant(1.5)), "white": Lambertian(reflectance: Constant(0.5)) }},
+            objects: [ {objects} ])"#
+        );
+        let scene = load_scene_str(&text, std::path::Path::new("t.ron"), &SettingsPatch::default()).unwrap();
+        scene.camera_media.entries().iter().map(|m| m.object).collect()
+    }
+
+    /// The camera's starting media: inside a solid (outermost first, by
+    /// distance), below a glass half-space, not in a bubble's cavity, not in
+    /// a diffuse object, not outside.
+    #[test]
+    fn the_camera_starts_in_the_media_around_its_eye() {
+        let nested = r#"(shape: Sphere(center: (0, 0, 0), radius: 0.5), material: "glass"),
+            (shape: Cuboid(min: (-2, -2, -2), max: (2, 2, 2)), material: "glass"),
+            (shape: Sphere(center: (0, 0, 0), radius: 1), material: "white")"#;
+        assert_eq!(camera_media("(0, 0, 0)", nested), [1, 0]);
+        assert_eq!(camera_media("(0, 1.5, 0)", nested), [1]);
+        assert_eq!(camera_media("(0, 3, 0)", nested), Vec::<u32>::new());
+        let plane = r#"(shape: Plane(point: (0, 1, 0), normal: (0, 1, 0)), material: "glass")"#;
+        assert_eq!(camera_media("(0, 0, 0)", plane), [0]);
+        assert_eq!(camera_media("(0, 2, 0)", plane), Vec::<u32>::new());
+        let bubble = r#"(shape: Bubble(center: (0, 0, 0), outer_radius: 1, inner_radius: 0.9), material: "glass")"#;
+        assert_eq!(camera_media("(0, 0, 0)", bubble), Vec::<u32>::new());
+        assert_eq!(camera_media("(0, 0.95, 0)", bubble), [0]);
+    }
+}
