@@ -19,10 +19,9 @@
 //!
 //! **Absorption** (`absorption: SPECTRUM`, σ per scene unit per bin): light
 //! travelling a distance `d` inside keeps `exp(−σ d)` (Beer-Lambert). The
-//! integrators apply it to every path segment that ends on this surface from
-//! the inside (the side opposite the normal), which is every segment inside a
-//! closed glass unless it ends on another object inside it (see README,
-//! "Materials").
+//! integrators apply it to every path segment and shadow ray that runs inside
+//! this object's volume while it is the path's current medium
+//! ([`super::medium`]), whatever the segment ends on.
 //!
 //! **Outside medium**: the outside is vacuum unless the path is inside an
 //! enclosing dielectric ([`super::medium`]): then every method that takes a

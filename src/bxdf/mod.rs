@@ -222,7 +222,7 @@ impl Bxdf {
 
     /// The absorption coefficient (per unit length) inside the model, for
     /// an absorbing dielectric: the integrators attenuate every segment that
-    /// reaches this surface from its inside by `exp(−σ t)`.
+    /// runs in it (the current medium, [`medium`]) by `exp(−σ t)`.
     #[inline]
     pub fn absorption(&self) -> Option<&Spectrum> {
         match self {
