@@ -29,17 +29,12 @@
 //! wavelength for one wavelength, at 589.3 nm for a larger packet), and
 //! those that compute it take the [`Outside`] medium.
 //!
-//! **Coating** (`coating: ThinFilm(thickness_nm:, ior:)`, smooth glass only):
-//! the film's Airy reflectance per wavelength replaces Fresnel's
-//! ([`super::thin_film`]); the film is thin, so the ray refracts as through
-//! the bare interface. The loader refuses a coating on rough glass: the rough model draws its lobe with, and
-//! evaluates, one Fresnel term per microfacet for the packet's single index
-//! (`rough_dielectric::{eval, pdf, sample}` return a scalar); a film makes the
-//! reflectance a function of wavelength and of the microfacet angle `wo·wm`
-//! (the Airy sum), so `f` would become a per-wavelength spectrum and the pdf of
-//! the lobe choice a packet average that `pdf` (called for MIS with the
-//! light sample) would have to reproduce exactly: a new model with its own
-//! chi-square and furnace tests, not a switch.
+//! **Coating** (`coating: ThinFilm(thickness_nm:, ior:)`): the film's Airy
+//! reflectance per wavelength replaces Fresnel's ([`super::thin_film`]); the
+//! film is thin, so the ray refracts as through the bare interface. On rough
+//! glass the film lies on every microfacet: `R(λ, wo·wm)` replaces `F` per
+//! wavelength in `f`, and the lobe is chosen with the packet's mean
+//! reflectance, which `pdf` reproduces (for one wavelength, its own).
 //!
 //! ```ron
 //! "glass": Dielectric(ior: Named("N-BK7")),
@@ -47,6 +42,7 @@
 //! "crown": Dielectric(ior: Constant(1.5)),
 //! "flint": Dielectric(ior: Cauchy(a: 1.67, b: 0.0074)),
 //! "frosted": Dielectric(ior: Constant(1.5), roughness: 0.15),
+//! "coated_frost": Dielectric(ior: Constant(1.5), roughness: 0.1, coating: ThinFilm(thickness_nm: 300, ior: Constant(1.38))),
 //! "green_glass": Dielectric(ior: Named("N-BK7"), absorption: Samples([...36 values per unit length...])),
 //! ```
 
@@ -139,9 +135,8 @@ impl Dielectric {
         self
     }
 
-    /// The same (smooth) glass under a thin film: its reflectance becomes the
-    /// film's Airy reflectance per wavelength (the loader refuses a coating
-    /// on rough glass).
+    /// The same glass under a thin film: its reflectance (every microfacet's,
+    /// on rough glass) becomes the film's Airy reflectance per wavelength.
     pub fn with_coating(mut self, film: ThinFilm) -> Self {
         self.coating = Some(film);
         self
@@ -190,6 +185,52 @@ impl Dielectric {
         if self.is_smooth() { 0.0 } else { rough_dielectric::pdf(Ggx { alpha: self.alpha }, wo, wi, eta) }
     }
 
+    /// `f(wo, wi)` for each of the packet's wavelengths at relative index
+    /// `eta` (`n_out`: the outside's index): per wavelength on coated rough
+    /// glass, the same for all otherwise.
+    #[inline]
+    pub fn eval_packet<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        (eta, n_out): (f32, f32),
+        lambdas: &Lambdas<N>,
+    ) -> Sampled<N> {
+        match &self.coating {
+            Some(_) if !self.is_smooth() => {
+                rough_dielectric::eval_coated(Ggx { alpha: self.alpha }, wo, wi, eta, |c| {
+                    Sampled(std::array::from_fn(|i| self.reflectance_at(c, eta, n_out, lambdas.pos[i])))
+                })
+            }
+            _ => Sampled::splat(self.eval(wo, wi, eta)),
+        }
+    }
+
+    /// The pdf of `sample_any` choosing `wi` for the packet at relative index
+    /// `eta`: coated rough glass chooses its lobe with the packet's mean film reflectance.
+    #[inline]
+    pub fn pdf_packet<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        (eta, n_out): (f32, f32),
+        lambdas: &Lambdas<N>,
+    ) -> f32 {
+        match &self.coating {
+            Some(_) if !self.is_smooth() => rough_dielectric::pdf_with(Ggx { alpha: self.alpha }, wo, wi, eta, |c| {
+                self.mean_film(c, eta, n_out, lambdas)
+            }),
+            _ => self.pdf(wo, wi, eta),
+        }
+    }
+
+    /// The coated reflectance at microfacet cosine `c`, averaged over the packet.
+    #[inline]
+    fn mean_film<const N: usize>(&self, c: f32, eta: f32, n_out: f32, lambdas: &Lambdas<N>) -> f32 {
+        let sum: f32 = lambdas.pos.iter().map(|&pos| self.reflectance_at(c, eta, n_out, pos)).sum();
+        (sum / N as f32).clamp(0.0, 1.0)
+    }
+
     /// Samples the smooth or rough interface for relative index `eta`
     /// (`n_out`: the outside's index, which only a coating needs).
     #[inline]
@@ -202,7 +243,18 @@ impl Dielectric {
         lambdas: &Lambdas<N>,
     ) -> Option<BsdfSample<N>> {
         if self.coating.is_some() {
-            return self.sample_coated(wo, uc, eta, n_out, lambdas);
+            if self.is_smooth() {
+                return self.sample_coated(wo, uc, eta, n_out, lambdas);
+            }
+            let g = Ggx { alpha: self.alpha };
+            let wi = rough_dielectric::sample_direction(g, wo, u, uc, eta, |c| self.mean_film(c, eta, n_out, lambdas))?;
+            let f = self.eval_packet(wo, wi, (eta, n_out), lambdas);
+            let pdf = self.pdf_packet(wo, wi, (eta, n_out), lambdas);
+            let (_, etap) = rough_dielectric::half_vector(wo, wi, eta)?;
+            if pdf.is_nan() || pdf <= 0.0 || f.is_black() {
+                return None;
+            }
+            return Some(BsdfSample { wi, f, pdf, is_delta: false, eta: etap });
         }
         if self.is_smooth() {
             return self.sample(wo, uc, eta);

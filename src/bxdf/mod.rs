@@ -122,7 +122,7 @@ impl Bxdf {
             Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
             Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
             Bxdf::Plastic(m) => m.eval(wo, wi, lambdas),
-            Bxdf::Dielectric(m) => Sampled::splat(m.eval(wo, wi, m.relative_eta_for(lambdas, outside).0)),
+            Bxdf::Dielectric(m) => m.eval_packet(wo, wi, m.relative_eta_for(lambdas, outside), lambdas),
             Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => Sampled::splat(0.0),
         }
     }
@@ -170,7 +170,7 @@ impl Bxdf {
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
             Bxdf::Conductor(m) => m.pdf(wo, wi),
             Bxdf::Plastic(m) => m.pdf(wo, wi, lambdas),
-            Bxdf::Dielectric(m) => m.pdf(wo, wi, m.relative_eta_for(lambdas, outside).0),
+            Bxdf::Dielectric(m) => m.pdf_packet(wo, wi, m.relative_eta_for(lambdas, outside), lambdas),
             Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => 0.0,
         }
     }

@@ -186,7 +186,7 @@ pub enum MaterialDesc {
         /// Absorption coefficient inside, per scene unit (default: clear).
         #[serde(default)]
         absorption: Option<SpectrumDesc>,
-        /// A thin film on the outside (smooth glass only): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
+        /// A thin film on the outside (on every microfacet of rough glass): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
         #[serde(default)]
         coating: Option<CoatingDesc>,
     },
