@@ -20,7 +20,8 @@
 //!   integral over 360-830 nm, `Σ_b L(b) · W_b` ([`color::color_weights`]), normalised so the
 //!   equal-energy spectrum of radiance 1 has `Y = 1`.
 //! - **Depth**: `max_bounces` counts scattering events ([`integrator`]).
-//! - **The outside medium** is vacuum, index 1 ([`bxdf`]).
+//! - **The outside medium** is vacuum, index 1, except inside dielectric
+//!   objects, which paths track on a medium stack ([`bxdf::medium`]).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -19,15 +19,22 @@
 //!
 //! **Absorption** (`absorption: SPECTRUM`, σ per scene unit per bin): light
 //! travelling a distance `d` inside keeps `exp(−σ d)` (Beer-Lambert). The
-//! integrators apply it to every path segment that ends on this surface from
-//! the inside (the side opposite the normal), which is every segment inside a
-//! closed glass unless it ends on another object inside it (see README,
-//! "Materials").
+//! integrators apply it to every path segment and shadow ray that runs inside
+//! this object's volume while it is the path's current medium
+//! ([`super::medium`]), whatever the segment ends on.
 //!
-//! **Coating** (`coating: ThinFilm(thickness_nm:, ior:)`, smooth glass only):
-//! the film's Airy reflectance per wavelength replaces Fresnel's
-//! ([`super::thin_film`]); the film is thin, so the ray refracts as through
-//! the bare interface.
+//! **Outside medium**: the outside is vacuum unless the path is inside an
+//! enclosing dielectric ([`super::medium`]): then every method that takes a
+//! relative index `eta` is called with `n_inside / n_outside` (per
+//! wavelength for one wavelength, at 589.3 nm for a larger packet), and
+//! those that compute it take the [`Outside`] medium.
+//!
+//! **Coating** (`coating: ThinFilm(thickness_nm:, ior:)`): the film's Airy
+//! reflectance per wavelength replaces Fresnel's ([`super::thin_film`]); the
+//! film is thin, so the ray refracts as through the bare interface. On rough
+//! glass the film lies on every microfacet: `R(λ, wo·wm)` replaces `F` per
+//! wavelength in `f`, and the lobe is chosen with the packet's mean
+//! reflectance, which `pdf` reproduces (for one wavelength, its own).
 //!
 //! ```ron
 //! "glass": Dielectric(ior: Named("N-BK7")),
@@ -35,6 +42,7 @@
 //! "crown": Dielectric(ior: Constant(1.5)),
 //! "flint": Dielectric(ior: Cauchy(a: 1.67, b: 0.0074)),
 //! "frosted": Dielectric(ior: Constant(1.5), roughness: 0.15),
+//! "coated_frost": Dielectric(ior: Constant(1.5), roughness: 0.1, coating: ThinFilm(thickness_nm: 300, ior: Constant(1.38))),
 //! "green_glass": Dielectric(ior: Named("N-BK7"), absorption: Samples([...36 values per unit length...])),
 //! ```
 
@@ -47,8 +55,49 @@ use crate::color::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, bin_lambda_nm};
 use crate::color::{Sampled, Spectrum};
 use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM};
 
-/// A smooth dielectric; the outside (the side the normal points to) is the
-/// scene's medium, of index 1 (vacuum; see the crate docs).
+/// The medium on the outside of a dielectric's surface: vacuum (index 1),
+/// or the inside of another dielectric that encloses the path there
+/// (nested dielectrics, [`super::medium`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Outside<'a>(Option<&'a Dielectric>);
+
+impl<'a> Outside<'a> {
+    /// Vacuum, index exactly 1.
+    pub const VACUUM: Outside<'static> = Outside(None);
+
+    /// The inside of dielectric `d`.
+    #[inline]
+    pub fn medium(d: &'a Dielectric) -> Self {
+        Outside(Some(d))
+    }
+
+    /// The outside's index at fractional bin position `pos`.
+    #[inline]
+    pub fn eta_at(&self, pos: f32) -> f32 {
+        self.0.map_or(1.0, |d| d.eta_at(pos))
+    }
+
+    /// The outside's index for a packet (as [`Dielectric::eta_for`]).
+    #[inline]
+    pub fn eta_for<const N: usize>(&self, lambdas: &Lambdas<N>) -> f32 {
+        self.0.map_or(1.0, |d| d.eta_for(lambdas))
+    }
+
+    /// The outside's index at the reference wavelength, 589.3 nm.
+    #[inline]
+    pub fn reference_eta(&self) -> f32 {
+        self.0.map_or(1.0, |d| d.reference_eta())
+    }
+
+    /// True when the outside's index varies with wavelength.
+    #[inline]
+    pub fn is_dispersive(&self) -> bool {
+        self.0.is_some_and(|d| d.ior().is_dispersive())
+    }
+}
+
+/// A dielectric interface; the outside (the side the normal points to) is
+/// vacuum or the enclosing medium ([`Outside`]).
 #[derive(Clone, Debug)]
 pub struct Dielectric {
     /// Index of refraction of the inside.
@@ -86,27 +135,27 @@ impl Dielectric {
         self
     }
 
-    /// The same (smooth) glass under a thin film: its reflectance becomes the
-    /// film's Airy reflectance per wavelength (the loader refuses a coating
-    /// on rough glass).
+    /// The same glass under a thin film: its reflectance (every microfacet's,
+    /// on rough glass) becomes the film's Airy reflectance per wavelength.
     pub fn with_coating(mut self, film: ThinFilm) -> Self {
         self.coating = Some(film);
         self
     }
 
     /// The reflectance for incidence cosine `cos` (negative: from inside),
-    /// relative index `eta` and fractional bin position `pos`: bare Fresnel,
-    /// or the coating's Airy reflectance (incident medium and substrate
-    /// swapped from inside; total internal reflection gives 1 unless the film
-    /// frustrates it).
+    /// relative index `eta`, outside index `n_out` (1 in vacuum) and
+    /// fractional bin position `pos`: bare Fresnel, or the coating's Airy
+    /// reflectance between the outside and the glass (incident medium and
+    /// substrate swapped from inside; total internal reflection gives 1
+    /// unless the film frustrates it).
     #[inline]
-    pub fn reflectance_at(&self, cos: f32, eta: f32, pos: f32) -> f32 {
+    pub fn reflectance_at(&self, cos: f32, eta: f32, n_out: f32, pos: f32) -> f32 {
         match &self.coating {
             None => fresnel_dielectric(cos, eta),
             Some(film) => {
                 let lambda = LAMBDA_MIN_NM + LAMBDA_STEP_NM * pos;
                 let nf = film.eta_at(pos);
-                let (ni, nt) = if cos >= 0.0 { (1.0, eta) } else { (eta, 1.0) };
+                let (ni, nt) = if cos >= 0.0 { (n_out, eta * n_out) } else { (eta * n_out, n_out) };
                 airy(cos.abs(), ni, nf, film.thickness_nm, nt, 0.0, lambda).0
             }
         }
@@ -136,18 +185,76 @@ impl Dielectric {
         if self.is_smooth() { 0.0 } else { rough_dielectric::pdf(Ggx { alpha: self.alpha }, wo, wi, eta) }
     }
 
-    /// Samples the smooth or rough interface for index `eta`.
+    /// `f(wo, wi)` for each of the packet's wavelengths at relative index
+    /// `eta` (`n_out`: the outside's index): per wavelength on coated rough
+    /// glass, the same for all otherwise.
+    #[inline]
+    pub fn eval_packet<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        (eta, n_out): (f32, f32),
+        lambdas: &Lambdas<N>,
+    ) -> Sampled<N> {
+        match &self.coating {
+            Some(_) if !self.is_smooth() => {
+                rough_dielectric::eval_coated(Ggx { alpha: self.alpha }, wo, wi, eta, |c| {
+                    Sampled(std::array::from_fn(|i| self.reflectance_at(c, eta, n_out, lambdas.pos[i])))
+                })
+            }
+            _ => Sampled::splat(self.eval(wo, wi, eta)),
+        }
+    }
+
+    /// The pdf of `sample_any` choosing `wi` for the packet at relative index
+    /// `eta`: coated rough glass chooses its lobe with the packet's mean film reflectance.
+    #[inline]
+    pub fn pdf_packet<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        (eta, n_out): (f32, f32),
+        lambdas: &Lambdas<N>,
+    ) -> f32 {
+        match &self.coating {
+            Some(_) if !self.is_smooth() => rough_dielectric::pdf_with(Ggx { alpha: self.alpha }, wo, wi, eta, |c| {
+                self.mean_film(c, eta, n_out, lambdas)
+            }),
+            _ => self.pdf(wo, wi, eta),
+        }
+    }
+
+    /// The coated reflectance at microfacet cosine `c`, averaged over the packet.
+    #[inline]
+    fn mean_film<const N: usize>(&self, c: f32, eta: f32, n_out: f32, lambdas: &Lambdas<N>) -> f32 {
+        let sum: f32 = lambdas.pos.iter().map(|&pos| self.reflectance_at(c, eta, n_out, pos)).sum();
+        (sum / N as f32).clamp(0.0, 1.0)
+    }
+
+    /// Samples the smooth or rough interface for relative index `eta`
+    /// (`n_out`: the outside's index, which only a coating needs).
     #[inline]
     pub fn sample_any<const N: usize>(
         &self,
         wo: Vec3,
         u: Vec2,
         uc: f32,
-        eta: f32,
+        (eta, n_out): (f32, f32),
         lambdas: &Lambdas<N>,
     ) -> Option<BsdfSample<N>> {
         if self.coating.is_some() {
-            return self.sample_coated(wo, uc, eta, lambdas);
+            if self.is_smooth() {
+                return self.sample_coated(wo, uc, eta, n_out, lambdas);
+            }
+            let g = Ggx { alpha: self.alpha };
+            let wi = rough_dielectric::sample_direction(g, wo, u, uc, eta, |c| self.mean_film(c, eta, n_out, lambdas))?;
+            let f = self.eval_packet(wo, wi, (eta, n_out), lambdas);
+            let pdf = self.pdf_packet(wo, wi, (eta, n_out), lambdas);
+            let (_, etap) = rough_dielectric::half_vector(wo, wi, eta)?;
+            if pdf.is_nan() || pdf <= 0.0 || f.is_black() {
+                return None;
+            }
+            return Some(BsdfSample { wi, f, pdf, is_delta: false, eta: etap });
         }
         if self.is_smooth() {
             return self.sample(wo, uc, eta);
@@ -186,11 +293,24 @@ impl Dielectric {
         if N == 1 { self.eta_at(lambdas.pos[0]) } else { self.reference_ior }
     }
 
-    /// The Fresnel reflectance at each of the packet's wavelengths, for a
-    /// direction `wo` (local frame) outside or inside.
+    /// The relative index `n_inside / n_outside` a packet refracts at, and
+    /// the outside's index (both as [`Dielectric::eta_for`]).
     #[inline]
-    pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
-        Sampled(std::array::from_fn(|i| self.reflectance_at(wo.z, self.eta_at(lambdas.pos[i]), lambdas.pos[i])))
+    pub fn relative_eta_for<const N: usize>(&self, lambdas: &Lambdas<N>, outside: Outside<'_>) -> (f32, f32) {
+        let n_out = outside.eta_for(lambdas);
+        (self.eta_for(lambdas) / n_out, n_out)
+    }
+
+    /// The Fresnel reflectance at each of the packet's wavelengths, for a
+    /// direction `wo` (local frame) outside or inside, each at its own
+    /// relative index against `outside`.
+    #[inline]
+    pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>, outside: Outside<'_>) -> Sampled<N> {
+        Sampled(std::array::from_fn(|i| {
+            let pos = lambdas.pos[i];
+            let n_out = outside.eta_at(pos);
+            self.reflectance_at(wo.z, self.eta_at(pos) / n_out, n_out, pos)
+        }))
     }
 
     /// Samples a coated smooth interface: each wavelength has its own
@@ -203,12 +323,13 @@ impl Dielectric {
         wo: Vec3,
         uc: f32,
         eta: f32,
+        n_out: f32,
         lambdas: &Lambdas<N>,
     ) -> Option<BsdfSample<N>> {
         if wo.z.abs() < f32::MIN_POSITIVE {
             return None;
         }
-        let r = Sampled::<N>(std::array::from_fn(|i| self.reflectance_at(wo.z, eta, lambdas.pos[i])));
+        let r = Sampled::<N>(std::array::from_fn(|i| self.reflectance_at(wo.z, eta, n_out, lambdas.pos[i])));
         let p = (r.0.iter().sum::<f32>() / N as f32).clamp(0.0, 1.0);
         let refracted = refract(wo, Vec3::Z, eta);
         if uc < p || p >= 1.0 || refracted.is_none() {
@@ -337,7 +458,7 @@ mod tests {
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let lambdas =
             Lambdas::<4> { pos: [0.0, 9.0, 18.0, 27.0], weight: 9.0, readout: crate::spectral::Readout::Spectral };
-        let fr = d.reflectance(wo, &lambdas);
+        let fr = d.reflectance(wo, &lambdas, Outside::VACUUM);
         for i in 0..4 {
             let eta = d.eta_at(lambdas.pos[i]);
             assert_eq!(fr[i], fresnel_dielectric(0.8, eta));

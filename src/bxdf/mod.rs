@@ -20,6 +20,11 @@
 //!   reference wavelength, 589.3 nm (only `path` and `whitted`, which do not
 //!   split, let one reach a dispersive surface).
 //!
+//! A dielectric's outside is vacuum unless a path is inside an enclosing
+//! dielectric: the `_within` forms of the verbs ([`Bxdf::sample_within`],
+//! ...) take that [`Outside`] medium, and [`medium`] holds the stack of media
+//! a path keeps (nested dielectrics). The plain verbs assume vacuum.
+//!
 //! Diffuse models, conductors and plastic are two-sided: they reflect into
 //! whichever hemisphere `wo` is in; a thin sheet is symmetric. The dielectric is oriented: `+z` is outside (the side the geometric
 //! normal points to), so `wo.z < 0` means the path is inside the glass.
@@ -29,6 +34,7 @@ mod dielectric;
 mod fresnel;
 mod ior;
 mod lambertian;
+pub mod medium;
 mod metals;
 pub mod microfacet;
 mod oren_nayar;
@@ -42,10 +48,11 @@ mod tests_rough;
 mod thin_film;
 
 pub use conductor::Conductor;
-pub use dielectric::Dielectric;
+pub use dielectric::{Dielectric, Outside};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, refract};
 pub use ior::{Ior, NAMED_GLASSES, named_glass};
 pub use lambertian::Lambertian;
+pub use medium::{Crossing, MEDIUM_STACK_DEPTH, Medium, MediumStack};
 pub use metals::{NAMED_METALS, named_metal};
 pub use oren_nayar::OrenNayar;
 pub use plastic::Plastic;
@@ -98,12 +105,24 @@ impl Bxdf {
     /// `f(wo, wi)` for the packet (zero for delta models).
     #[inline]
     pub fn eval<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
+        self.eval_within(wo, wi, lambdas, Outside::VACUUM)
+    }
+
+    /// [`Bxdf::eval`] with `outside` on a dielectric's outside (other models ignore it).
+    #[inline]
+    pub fn eval_within<const N: usize>(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        lambdas: &Lambdas<N>,
+        outside: Outside<'_>,
+    ) -> Sampled<N> {
         match self {
             Bxdf::Lambertian(m) => m.eval(wo, wi, lambdas),
             Bxdf::OrenNayar(m) => m.eval(wo, wi, lambdas),
             Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
             Bxdf::Plastic(m) => m.eval(wo, wi, lambdas),
-            Bxdf::Dielectric(m) => Sampled::splat(m.eval(wo, wi, m.eta_for(lambdas))),
+            Bxdf::Dielectric(m) => m.eval_packet(wo, wi, m.relative_eta_for(lambdas, outside), lambdas),
             Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => Sampled::splat(0.0),
         }
     }
@@ -112,12 +131,25 @@ impl Bxdf {
     /// choice), for the packet `lambdas` (see the module docs for dispersion).
     #[inline]
     pub fn sample<const N: usize>(&self, wo: Vec3, u: Vec2, uc: f32, lambdas: &Lambdas<N>) -> Option<BsdfSample<N>> {
+        self.sample_within(wo, u, uc, lambdas, Outside::VACUUM)
+    }
+
+    /// [`Bxdf::sample`] with `outside` on a dielectric's outside (other models ignore it).
+    #[inline]
+    pub fn sample_within<const N: usize>(
+        &self,
+        wo: Vec3,
+        u: Vec2,
+        uc: f32,
+        lambdas: &Lambdas<N>,
+        outside: Outside<'_>,
+    ) -> Option<BsdfSample<N>> {
         match self {
             Bxdf::Black => None,
             Bxdf::Lambertian(m) => m.sample(wo, u, lambdas),
             Bxdf::OrenNayar(m) => m.sample(wo, u, lambdas),
             Bxdf::Mirror(m) => m.sample(wo, lambdas),
-            Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.eta_for(lambdas), lambdas),
+            Bxdf::Dielectric(m) => m.sample_any(wo, u, uc, m.relative_eta_for(lambdas, outside), lambdas),
             Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
             Bxdf::Plastic(m) => m.sample(wo, u, uc, lambdas),
             Bxdf::ThinSheet(m) => m.sample(wo, uc, lambdas),
@@ -128,12 +160,27 @@ impl Bxdf {
     /// for delta models; rough glass samples at the packet's index, as `sample`).
     #[inline]
     pub fn pdf<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> f32 {
+        self.pdf_within(wo, wi, lambdas, Outside::VACUUM)
+    }
+
+    /// [`Bxdf::pdf`] with `outside` on a dielectric's outside (other models ignore it).
+    #[inline]
+    pub fn pdf_within<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>, outside: Outside<'_>) -> f32 {
         match self {
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => lambertian::pdf(wo, wi),
             Bxdf::Conductor(m) => m.pdf(wo, wi),
             Bxdf::Plastic(m) => m.pdf(wo, wi, lambdas),
-            Bxdf::Dielectric(m) => m.pdf(wo, wi, m.eta_for(lambdas)),
+            Bxdf::Dielectric(m) => m.pdf_packet(wo, wi, m.relative_eta_for(lambdas, outside), lambdas),
             Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => 0.0,
+        }
+    }
+
+    /// The dielectric, when this model is one (a medium for nested dielectrics).
+    #[inline]
+    pub fn as_dielectric(&self) -> Option<&Dielectric> {
+        match self {
+            Bxdf::Dielectric(d) => Some(d),
+            _ => None,
         }
     }
 
@@ -152,8 +199,17 @@ impl Bxdf {
     /// wavelength; `None` otherwise.
     #[inline]
     pub fn dispersion(&self) -> Option<Dispersion<'_>> {
+        self.dispersion_within(Outside::VACUUM)
+    }
+
+    /// [`Bxdf::dispersion`] with `outside` on a dielectric's outside: an
+    /// interface disperses when either side's index varies with wavelength.
+    #[inline]
+    pub fn dispersion_within<'a>(&'a self, outside: Outside<'a>) -> Option<Dispersion<'a>> {
         match self {
-            Bxdf::Dielectric(d) if d.ior().is_dispersive() => Some(Dispersion(d)),
+            Bxdf::Dielectric(d) if d.ior().is_dispersive() || outside.is_dispersive() => {
+                Some(Dispersion { glass: d, outside })
+            }
             _ => None,
         }
     }
@@ -166,7 +222,7 @@ impl Bxdf {
 
     /// The absorption coefficient (per unit length) inside the model, for
     /// an absorbing dielectric: the integrators attenuate every segment that
-    /// reaches this surface from its inside by `exp(−σ t)`.
+    /// runs in it (the current medium, [`medium`]) by `exp(−σ t)`.
     #[inline]
     pub fn absorption(&self) -> Option<&Spectrum> {
         match self {
@@ -187,7 +243,10 @@ impl Bxdf {
 /// and a refraction whose direction depends on it. [`Bxdf::dispersion`]
 /// hands it out, so integrators never match a model by name.
 #[derive(Clone, Copy, Debug)]
-pub struct Dispersion<'a>(&'a Dielectric);
+pub struct Dispersion<'a> {
+    glass: &'a Dielectric,
+    outside: Outside<'a>,
+}
 
 impl Dispersion<'_> {
     /// True for smooth glass: its reflection sends every wavelength the same
@@ -196,34 +255,35 @@ impl Dispersion<'_> {
     /// then samples, and takes its light sample, at its own index).
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        self.0.is_smooth()
+        self.glass.is_smooth()
     }
 
-    /// The relative index at the reference wavelength, 589.3 nm.
+    /// The relative index (inside / outside) at the reference wavelength, 589.3 nm.
     #[inline]
     pub fn reference_eta(&self) -> f32 {
-        self.0.reference_eta()
+        self.glass.reference_eta() / self.outside.reference_eta()
     }
 
     /// The relative index at fractional bin position `pos`.
     #[inline]
     pub fn eta_at(&self, pos: f32) -> f32 {
-        self.0.eta_at(pos)
+        self.glass.eta_at(pos) / self.outside.eta_at(pos)
     }
 
     /// The reflectance at incidence cosine `cos` for the bin at fractional
-    /// position `pos`, at that bin's index (the film's where the glass is coated).
+    /// position `pos`, at that bin's relative index (the film's where the glass is coated).
     #[inline]
     pub fn reflectance_at(&self, cos: f32, pos: f32) -> f32 {
-        self.0.reflectance_at(cos, self.0.eta_at(pos), pos)
+        self.glass.reflectance_at(cos, self.eta_at(pos), self.outside.eta_at(pos), pos)
     }
 
     /// The reflectance at the reference wavelength (589.3 nm) for incidence cosine `cos`.
     #[inline]
     pub fn reference_reflectance(&self, cos: f32) -> f32 {
-        self.0.reflectance_at(
+        self.glass.reflectance_at(
             cos,
-            self.0.reference_eta(),
+            self.reference_eta(),
+            self.outside.reference_eta(),
             (crate::spectral::REFERENCE_LAMBDA_NM - crate::color::LAMBDA_MIN_NM) / crate::color::LAMBDA_STEP_NM,
         )
     }
@@ -231,7 +291,7 @@ impl Dispersion<'_> {
     /// The reflectance at each of the packet's wavelengths for `wo`.
     #[inline]
     pub fn reflectance<const N: usize>(&self, wo: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {
-        self.0.reflectance(wo, lambdas)
+        self.glass.reflectance(wo, lambdas, self.outside)
     }
 
     /// The refraction alone for a single wavelength, as a sample of
@@ -240,7 +300,7 @@ impl Dispersion<'_> {
     /// total internal reflection.
     #[inline]
     pub fn sample_refraction(&self, wo: Vec3, lambdas: &Lambdas<1>) -> Option<BsdfSample<1>> {
-        self.0.sample_refraction(wo, self.0.eta_for(lambdas))
+        self.glass.sample_refraction(wo, self.glass.relative_eta_for(lambdas, self.outside).0)
     }
 }
 

@@ -15,11 +15,18 @@
 //! refraction otherwise; the pdf is the visible-normal density times the
 //! Jacobian of reflection `1 / (4 |wo·wm|)` or refraction
 //! `|wi·wm| / (wi·wm + wo·wm / η')²`.
+//!
+//! **Coated** (a thin film on every microfacet, [`super::thin_film`]): the
+//! film's reflectance `R(λ, wo·wm)` replaces `F` per wavelength in `f`
+//! ([`eval_coated`]), and the lobe is chosen with the packet's mean `P(wo·wm)`
+//! ([`pdf_with`], [`sample_direction`]); the film is thin, so directions are
+//! the bare interface's.
 
 use glam::{Vec2, Vec3};
 
 use super::fresnel_dielectric;
 use super::microfacet::Ggx;
+use crate::color::Sampled;
 
 /// A sampled direction of the rough interface: `wi`, `f`, pdf and `η'`.
 pub(super) struct RoughSample {
@@ -33,7 +40,7 @@ pub(super) struct RoughSample {
 /// upper hemisphere, and `η'` (1 for reflection); `None` when degenerate or
 /// when either direction sees the back of the microfacet.
 #[inline]
-fn half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Option<(Vec3, f32)> {
+pub(super) fn half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Option<(Vec3, f32)> {
     let (co, ci) = (wo.z, wi.z);
     if co == 0.0 || ci == 0.0 {
         return None;
@@ -54,6 +61,32 @@ fn half_vector(wo: Vec3, wi: Vec3, eta: f32) -> Option<(Vec3, f32)> {
         return None;
     }
     Some((wm, etap))
+}
+
+/// `f(wo, wi)` of the coated rough interface for each wavelength of a
+/// packet, whose film reflects `film(wo·wm)` (one value per wavelength).
+#[inline]
+pub(super) fn eval_coated<const N: usize>(
+    g: Ggx,
+    wo: Vec3,
+    wi: Vec3,
+    eta: f32,
+    film: impl Fn(f32) -> Sampled<N>,
+) -> Sampled<N> {
+    let Some((wm, etap)) = half_vector(wo, wi, eta) else {
+        return Sampled::splat(0.0);
+    };
+    let r = film(wo.dot(wm));
+    let (co, ci) = (wo.z, wi.z);
+    let f = if etap == 1.0 && co * ci > 0.0 {
+        r * (g.d(wm) * g.g2(wo, wi) / (4.0 * co * ci).abs())
+    } else {
+        let denom = wi.dot(wm) + wo.dot(wm) / etap;
+        let denom = denom * denom * co * ci;
+        Sampled(r.0.map(|r| 1.0 - r))
+            * (g.d(wm) * g.g2(wo, wi) * (wi.dot(wm) * wo.dot(wm) / denom).abs() / (etap * etap))
+    };
+    Sampled(f.0.map(|v| if v.is_finite() && v > 0.0 { v } else { 0.0 }))
 }
 
 /// `f(wo, wi)` of the rough interface for relative index `eta`.
@@ -77,10 +110,17 @@ pub(super) fn eval(g: Ggx, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
 /// The pdf of [`sample`] choosing `wi`.
 #[inline]
 pub(super) fn pdf(g: Ggx, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    pdf_with(g, wo, wi, eta, |c| fresnel_dielectric(c, eta))
+}
+
+/// The pdf of choosing `wi` when reflection is chosen with probability
+/// `select(wo·wm)` (Fresnel for bare glass, the film's mean for coated).
+#[inline]
+pub(super) fn pdf_with(g: Ggx, wo: Vec3, wi: Vec3, eta: f32, select: impl Fn(f32) -> f32) -> f32 {
     let Some((wm, etap)) = half_vector(wo, wi, eta) else {
         return 0.0;
     };
-    let r = fresnel_dielectric(wo.dot(wm), eta);
+    let r = select(wo.dot(wm));
     let dv = visible_density(g, wo, wm);
     let p = if etap == 1.0 && wo.z * wi.z > 0.0 {
         dv / (4.0 * wo.dot(wm).abs()) * r
@@ -101,6 +141,27 @@ fn visible_density(g: Ggx, wo: Vec3, wm: Vec3) -> f32 {
 /// normal, `uc`: the lobe).
 #[inline]
 pub(super) fn sample(g: Ggx, wo: Vec3, u: Vec2, uc: f32, eta: f32) -> Option<RoughSample> {
+    let wi = sample_direction(g, wo, u, uc, eta, |c| fresnel_dielectric(c, eta))?;
+    let f = eval(g, wo, wi, eta);
+    let pdf = pdf(g, wo, wi, eta);
+    if !(f > 0.0 && pdf > 0.0) {
+        return None;
+    }
+    let (_, etap) = half_vector(wo, wi, eta)?;
+    Some(RoughSample { wi, f, pdf, etap })
+}
+
+/// A direction off a visible microfacet, reflecting with probability
+/// `select(wo·wm)` and refracting (at `eta`) otherwise.
+#[inline]
+pub(super) fn sample_direction(
+    g: Ggx,
+    wo: Vec3,
+    u: Vec2,
+    uc: f32,
+    eta: f32,
+    select: impl Fn(f32) -> f32,
+) -> Option<Vec3> {
     if wo.z.abs() < f32::MIN_POSITIVE {
         return None;
     }
@@ -109,25 +170,18 @@ pub(super) fn sample(g: Ggx, wo: Vec3, u: Vec2, uc: f32, eta: f32) -> Option<Rou
     // The normal in the upper hemisphere, as `half_vector` returns it.
     let wm = if wo.z < 0.0 { -wm_up } else { wm_up };
     let wm = if wm.z < 0.0 { -wm } else { wm };
-    let r = fresnel_dielectric(wo.dot(wm), eta);
-    let wi = if uc < r {
+    let r = select(wo.dot(wm));
+    if uc < r {
         let wi = 2.0 * wo.dot(wm) * wm - wo;
         if wi.z * wo.z <= 0.0 {
             return None;
         }
-        wi
+        Some(wi)
     } else {
         let (wi, _) = super::refract(wo, wm, eta)?;
         if wi.z * wo.z >= 0.0 {
             return None;
         }
-        wi
-    };
-    let f = eval(g, wo, wi, eta);
-    let pdf = pdf(g, wo, wi, eta);
-    if !(f > 0.0 && pdf > 0.0) {
-        return None;
+        Some(wi)
     }
-    let (_, etap) = half_vector(wo, wi, eta)?;
-    Some(RoughSample { wi, f, pdf, etap })
 }

@@ -298,3 +298,87 @@ fn chi_square_plastic() {
         }
     }
 }
+
+/// Rough glass under a thin film (n 1.5, film 300 nm of n 1.38): `sample`
+/// against `pdf` for one wavelength (the lobe chosen with that wavelength's
+/// film reflectance), from outside and inside, as `chi_square_rough_dielectric`.
+#[test]
+fn chi_square_coated_rough_dielectric() {
+    let thetas = [0.0f32, 50.0, 140.0];
+    let sig = 1.0 - 0.99f64.powf(1.0 / (2 * thetas.len()) as f64);
+    let film = ThinFilm::new(300.0, &Ior::Constant(1.38));
+    let mut seed = 300;
+    for alpha in [0.2f32, 0.5] {
+        let b = Bxdf::Dielectric(Dielectric::new(Ior::Constant(1.5)).with_roughness(alpha).with_coating(film.clone()));
+        let l = Lambdas::<1> { pos: [12.0], weight: 36.0, readout: crate::spectral::Readout::Spectral };
+        for theta in thetas {
+            let t = theta.to_radians();
+            let wo = Vec3::new(t.sin() * 0.6, t.sin() * 0.8, t.cos()).normalize();
+            let expected = expected_counts_sub(|wi| b.pdf(wo, wi, &l), 100_000, 48);
+            seed += 1;
+            let observed = sampled_counts(&b, wo, &l, 100_000, seed, |bs| {
+                assert!(!bs.is_delta && bs.pdf > 0.0);
+                true
+            });
+            let p = chi2_test(&observed, &expected);
+            assert!(p > sig, "coated rough glass α {alpha}, θo = {theta}°: p = {p:e} < {sig:e}");
+        }
+    }
+}
+
+/// Coated rough glass against independent truths: a film of thickness 0 is
+/// no film, so `eval` and `pdf` equal the bare rough glass's (within f32
+/// rounding of the Airy sum); for the full spectrum `sample` agrees with
+/// `eval` and `pdf`, and R + T ≤ 1 per bin; and near the smooth limit
+/// (α = 0.002) the reflected share of each bin is the film's Airy
+/// reflectance `thin_film::airy` at the incidence angle (within 0.01).
+#[test]
+fn coated_rough_glass_matches_bare_glass_and_the_airy_formula() {
+    let glass = |d: f32, alpha: f32| {
+        Bxdf::Dielectric(
+            Dielectric::new(Ior::Constant(1.5))
+                .with_roughness(alpha)
+                .with_coating(ThinFilm::new(d, &Ior::Constant(1.38))),
+        )
+    };
+    let (bare, none) = (rough_glass(Ior::Constant(1.5), 0.3), glass(0.0, 0.3));
+    let l = Lambdas::full();
+    for (mo, mi) in [(0.9f32, 0.7f32), (0.5, -0.6), (-0.8, -0.4), (-0.3, 0.9), (0.2, 0.3)] {
+        let (wo, wi) = (dir(mo, 0.3), dir(mi, 2.0));
+        let (a, b) = (bare.eval(wo, wi, &l), none.eval(wo, wi, &l));
+        for k in 0..N_BINS {
+            assert!((a[k] - b[k]).abs() <= 1e-4 * a[k].max(1e-3), "d = 0: f {} vs {}", b[k], a[k]);
+        }
+        let (pa, pb) = (bare.pdf(wo, wi, &l), none.pdf(wo, wi, &l));
+        assert!((pa - pb).abs() <= 1e-4 * pa.max(1e-3), "d = 0: pdf {pb} vs {pa}");
+    }
+    for mu in [0.9f32, 0.4, -0.7] {
+        let (b, wo) = (glass(300.0, 0.3), dir(mu, 0.2));
+        check_sample_consistency(&b, wo, 20_000);
+        // R + T in energy (radiance weights times η², as Walter's test above).
+        let mut s = Sampler::new(4, 5, 6);
+        let (mut total, n) = (Spectrum::ZERO, 20_000);
+        for _ in 0..n {
+            if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l) {
+                total += bs.f * (bs.wi.z.abs() / bs.pdf * bs.eta * bs.eta);
+            }
+        }
+        assert!(total.0.iter().all(|&v| v / n as f32 <= 1.0 + 0.02), "μ {mu}: R + T above 1: {total:?}");
+    }
+    let (b, cos) = (glass(300.0, 0.002), 0.8f32);
+    let wo = dir(cos, 0.0);
+    let mut s = Sampler::new(8, 9, 10);
+    let (mut reflected, n) = (Spectrum::ZERO, 50_000);
+    for _ in 0..n {
+        if let Some(bs) = b.sample(wo, s.next_2d(), s.next_1d(), &l)
+            && bs.wi.z > 0.0
+        {
+            reflected += bs.f * (bs.wi.z.abs() / bs.pdf);
+        }
+    }
+    for k in (0..N_BINS).step_by(5) {
+        let want = airy(cos, 1.0, 1.38, 300.0, 1.5, 0.0, crate::color::bin_lambda_nm(k)).0;
+        let got = reflected[k] / n as f32;
+        assert!((got - want).abs() < 0.01, "bin {k}: reflected {got} vs Airy {want}");
+    }
+}

@@ -306,8 +306,8 @@ mod tests {
             let l = Lambdas::full();
             for c in [1.0f32, 0.5, 0.05, -0.9, -0.8, -0.5] {
                 let wo = Vec3::new((1.0 - c * c).sqrt(), 0.0, c);
-                let refl: BsdfSample<36> = glass.sample_any(wo, glam::Vec2::ZERO, 0.0, 1.5, &l).unwrap();
-                let tr: BsdfSample<36> = glass.sample_any(wo, glam::Vec2::ZERO, 1.0 - 1e-7, 1.5, &l).unwrap();
+                let refl: BsdfSample<36> = glass.sample_any(wo, glam::Vec2::ZERO, 0.0, (1.5, 1.0), &l).unwrap();
+                let tr: BsdfSample<36> = glass.sample_any(wo, glam::Vec2::ZERO, 1.0 - 1e-7, (1.5, 1.0), &l).unwrap();
                 for b in 0..36 {
                     let (ni, nt) = if c > 0.0 { (1.0, 1.5) } else { (1.5, 1.0) };
                     let (r, _) = airy(c, ni, 1.38, d, nt, 0.0, bin_lambda_nm(b));

@@ -18,6 +18,15 @@
 //! path, as pbrt-v4's `maxdepth`: 0 shows only emitters seen directly, 1 adds
 //! direct lighting. A path of `k` bounces has `k + 1` segments, so Mitsuba's
 //! `max_depth = k + 1`. The NEE shadow ray from the `k`-th bounce is allowed.
+//!
+//! # Nested dielectrics
+//! Every path carries a [`MediumStack`] (starting as [`Scene::camera_media`]):
+//! at a dielectric's surface, `interface` decides whether the hit is a
+//! false intersection (passed straight through, no bounce counted, no light
+//! sample) or a real interface and what lies outside it; a transmission
+//! updates the stack (`Interface::scattered`). Segments, and shadow rays,
+//! are absorbed by the medium they run in (`Surround`). A path may pass at
+//! most `MAX_PASSES` (64) false intersections in a row (then it ends).
 
 mod bdpt;
 mod path;
@@ -29,13 +38,13 @@ pub use whitted::Whitted;
 
 use glam::{Vec2, Vec3};
 
-use crate::bxdf::Bxdf;
+use crate::bxdf::{Bxdf, Crossing, Medium, MediumStack, Outside};
+use crate::color::{Sampled, Spectrum};
 use crate::film::Splat;
-use crate::color::Sampled;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceHit};
 use crate::settings::{IntegratorKind, WavelengthsKind};
 use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet};
 
@@ -144,8 +153,13 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
 /// True when the scene has light that path tracing cannot reach well: a
 /// delta light (point, spot, distant, beam) together with a specular
 /// surface (smooth glass, mirror, smooth metal, thin sheet), whose caustics
-/// no camera path can connect to the light. `auto` then picks `bdpt`.
+/// no camera path can connect to the light. `auto` then picks `bdpt`, unless
+/// dielectrics nest or overlap ([`Scene::has_nested_media`]): `bdpt` has no
+/// medium stack, so there `auto` keeps path tracing.
 pub fn needs_bdpt(scene: &Scene) -> bool {
+    if scene.has_nested_media() {
+        return false;
+    }
     let delta_light = scene.lights.iter().any(|l| l.is_delta());
     delta_light && scene.objects.iter().any(|o| scene.materials[o.material as usize].is_delta())
 }
@@ -167,6 +181,10 @@ pub fn describe(scene: &Scene) -> String {
         IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),
         IntegratorKind::Path if dispersive => "path: full spectrum; dispersive glass refracts every wavelength like 589.3 nm (no rainbow)".into(),
         IntegratorKind::Path => "path: full-spectrum path tracing".into(),
+        IntegratorKind::Bdpt | IntegratorKind::LightTrace if scene.has_nested_media() => format!(
+            "{}: WARNING: dielectrics nest or overlap here, and {0} has no medium stack: every dielectric surface is treated as if vacuum were outside (use auto or path)",
+            s.integrator.name()
+        ),
         IntegratorKind::Bdpt => "bdpt: bidirectional path tracing, every strategy combined by MIS (power heuristic)".into(),
         IntegratorKind::LightTrace => "lighttrace: light subpaths connected to the camera only (no camera paths)".into(),
         IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
@@ -216,14 +234,115 @@ impl Shading {
     }
 }
 
+/// The most false intersections a path passes in a row before it ends (a
+/// guard against degenerate geometry; real scenes need a handful).
+pub(crate) const MAX_PASSES: u32 = 64;
+
+/// A path's view of a surface hit among nested dielectrics.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Interface<'a> {
+    /// A false intersection: go straight on (the stack is already updated).
+    Pass,
+    /// Scatter here, with `outside` on a dielectric's outside; `crossing`
+    /// is the medium whose surface this is and whether the path enters it.
+    Scatter { outside: Outside<'a>, crossing: Option<(Medium, bool)> },
+}
+
+impl<'a> Interface<'a> {
+    /// The medium outside the dielectric (vacuum for other surfaces).
+    #[inline]
+    pub fn outside(&self) -> Outside<'a> {
+        match self {
+            Interface::Scatter { outside, .. } => *outside,
+            Interface::Pass => Outside::VACUUM,
+        }
+    }
+
+    /// After scattering into world direction `wi` at a surface of geometric
+    /// normal `n` reached along `dir`: a transmission through a medium's
+    /// surface enters or leaves it.
+    #[inline]
+    pub fn scattered(&self, media: &mut MediumStack, dir: Vec3, n: Vec3, wi: Vec3) {
+        if let Interface::Scatter { crossing: Some((m, entering)), .. } = *self
+            && wi.dot(n) * dir.dot(n) > 0.0
+        {
+            media.cross(m, entering);
+        }
+    }
+
+    /// The absorption on both sides of the surface, for shadow rays: the
+    /// medium the path is in (`media`, before crossing) and the one a
+    /// transmission would reach.
+    #[inline]
+    pub fn surround(&self, scene: &'a Scene, media: &MediumStack) -> Surround<'a> {
+        let front = absorption(scene, media.current());
+        let back = match self {
+            Interface::Scatter { crossing: Some((m, true)), .. } => absorption(scene, Some(*m)),
+            Interface::Scatter { crossing: Some((m, false)), .. } => {
+                let mut after = *media;
+                after.leave(m.object);
+                absorption(scene, after.current())
+            }
+            _ => front,
+        };
+        Surround { outside: self.outside(), front, back }
+    }
+}
+
+/// What a hit on object `si.object`, reached along `dir`, is for a path in
+/// `media`: a false intersection (then `media` is updated) or a surface to
+/// scatter at.
+#[inline]
+pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut MediumStack, si: &SurfaceHit, dir: Vec3) -> Interface<'a> {
+    let Some(m) = scene.medium(si.object) else {
+        return Interface::Scatter { outside: Outside::VACUUM, crossing: None };
+    };
+    let entering = dir.dot(si.hit.n) < 0.0;
+    match media.crossing(m, entering) {
+        Crossing::Pass => {
+            media.cross(m, entering);
+            Interface::Pass
+        }
+        Crossing::Interface { outside } => {
+            let outside = match outside.and_then(|o| scene.materials[o as usize].as_dielectric()) {
+                Some(d) => Outside::medium(d),
+                None => Outside::VACUUM,
+            };
+            Interface::Scatter { outside, crossing: Some((m, entering)) }
+        }
+    }
+}
+
+/// The absorption coefficient of `medium` (`None`: vacuum or clear).
+#[inline]
+pub(crate) fn absorption(scene: &Scene, medium: Option<Medium>) -> Option<&Spectrum> {
+    scene.materials[medium?.material as usize].absorption()
+}
+
+/// Around a vertex, for its light sample: the medium outside the
+/// dielectric whose surface it is (vacuum for other surfaces), and the
+/// absorption a shadow ray meets on `wo`'s side and across the surface.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Surround<'a> {
+    /// The medium on a dielectric's outside.
+    pub outside: Outside<'a>,
+    /// Absorption on `wo`'s side.
+    pub front: Option<&'a Spectrum>,
+    /// Absorption across the surface (a transmitted shadow ray).
+    pub back: Option<&'a Spectrum>,
+}
+
 /// One next-event estimate at a non-delta surface: a light chosen by power, a
-/// point on it sampled by solid angle or area, a shadow ray, and the MIS
-/// weight against BSDF sampling (power heuristic) when `mis` is set.
+/// point on it sampled by solid angle or area, a shadow ray (absorbed by the
+/// medium it runs in, `surround`), and the MIS weight against BSDF sampling
+/// (power heuristic) when `mis` is set.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub(crate) fn sample_direct<const N: usize>(
     scene: &Scene,
     bxdf: &Bxdf,
     sh: &Shading,
+    surround: Surround<'_>,
     lambdas: &Lambdas<N>,
     sampler: &mut Sampler,
     mis: bool,
@@ -242,7 +361,7 @@ pub(crate) fn sample_direct<const N: usize>(
     if !sh.consistent(ls.wi, wi_local) {
         return zero;
     }
-    let f = bxdf.eval(sh.wo, wi_local, lambdas);
+    let mut f = bxdf.eval_within(sh.wo, wi_local, lambdas, surround.outside);
     if f.is_black() {
         return zero;
     }
@@ -250,7 +369,75 @@ pub(crate) fn sample_direct<const N: usize>(
     if scene.occluded(&shadow, t_max) {
         return zero;
     }
+    let medium = if ls.wi.dot(sh.n) * sh.wo_n > 0.0 { surround.front } else { surround.back };
+    if let Some(sigma) = medium {
+        f *= (lambdas.sample(sigma) * -(ls.point - sh.p).length()).exp();
+    }
     let pdf_light = pmf * ls.pdf;
-    let weight = if ls.is_delta || !mis { 1.0 } else { power_heuristic(pdf_light, bxdf.pdf(sh.wo, wi_local, lambdas)) };
+    let weight = if ls.is_delta || !mis {
+        1.0
+    } else {
+        power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, surround.outside))
+    };
     f * lambdas.sample(light.spectrum()) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::SettingsPatch;
+
+    /// Water (1.33) in glass (1.5): the interface the medium stack finds
+    /// refracts by Snell's law with both absolute indices, n_glass sin θ_g =
+    /// n_water sin θ_w, on the way in and out of the water; and beyond the
+    /// critical angle glass → water (sin θ_g > 1.33/1.5) it reflects totally,
+    /// where a vacuum outside would have refracted.
+    #[test]
+    fn water_in_glass_refracts_with_the_relative_index() {
+        let text = r#"(camera: (eye: (0, 0, 5), look_at: (0, 0, 0), fov_deg: 30),
+            materials: { "glass": Dielectric(ior: Constant(1.5)), "water": Dielectric(ior: Constant(1.33)) },
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"),
+                       (shape: Sphere(center: (0, 0, 0), radius: 0.5), material: "water") ])"#;
+        let scene =
+            crate::scene::load_scene_str(text, std::path::Path::new("t.ron"), &SettingsPatch::default()).unwrap();
+        let lambdas = Lambdas::full();
+        let sin_between = |a: Vec3, n: Vec3| a.normalize().cross(n).length();
+        // A ray inside the glass, hitting the water at incidence sine `sin_g`.
+        let refract = |media: &mut MediumStack, ray: Ray| {
+            let si = scene.intersect(&ray, f32::INFINITY).unwrap();
+            let at = interface(&scene, media, &si, ray.dir);
+            assert!(matches!(at, Interface::Scatter { .. }));
+            let sh = Shading::new(si.hit.p, si.hit.n, si.hit.ns, ray.dir);
+            let bxdf = &scene.materials[scene.objects[si.object as usize].material as usize];
+            let bs = bxdf.sample_within(sh.wo, Vec2::ZERO, 1.0 - 1e-7, &lambdas, at.outside()).unwrap();
+            let wi = sh.frame.to_world(bs.wi);
+            at.scattered(media, ray.dir, si.hit.n, wi);
+            (si, wi)
+        };
+        let glass = scene.medium(0).unwrap();
+        let water = scene.medium(1).unwrap();
+        let mut media = MediumStack::VACUUM;
+        media.enter(glass);
+        let (si, wi) = refract(&mut media, Ray::new(Vec3::new(-0.8, 0.3, 0.0), Vec3::X));
+        let (sin_g, sin_w) = (sin_between(Vec3::X, si.hit.n), sin_between(wi, si.hit.n));
+        assert!((sin_g - 0.6).abs() < 1e-5 && wi.dot(si.hit.n) < 0.0, "into the water");
+        assert!((1.5 * sin_g - 1.33 * sin_w).abs() < 1e-5, "Snell into water: {sin_g} {sin_w}");
+        assert_eq!(media.current(), Some(water));
+        // On through the water and out into the glass again.
+        let (si2, wi2) = refract(&mut media, Ray::spawn(si.hit.p, si.hit.n, wi));
+        let (sin_w2, sin_g2) = (sin_between(wi, si2.hit.n), sin_between(wi2, si2.hit.n));
+        assert!(wi2.dot(si2.hit.n) > 0.0, "out of the water");
+        assert!((1.33 * sin_w2 - 1.5 * sin_g2).abs() < 1e-5, "Snell out of water: {sin_w2} {sin_g2}");
+        assert_eq!(media.current(), Some(glass));
+        // Beyond glass → water's critical angle: total internal reflection.
+        let ray = Ray::new(Vec3::new(-0.8, 0.48, 0.0), Vec3::X);
+        let (si, wi) = refract(&mut media, ray);
+        assert!(sin_between(Vec3::X, si.hit.n) > 1.33 / 1.5);
+        assert!(wi.dot(si.hit.n) > 0.0, "reflected back into the glass");
+        assert_eq!(media.current(), Some(glass), "reflected: still in the glass");
+        // With vacuum outside, the same hit would have refracted.
+        let mut vacuum = MediumStack::VACUUM;
+        let (si, wi) = refract(&mut vacuum, ray);
+        assert!(wi.dot(si.hit.n) < 0.0 && vacuum.current() == Some(water));
+    }
 }

@@ -3,10 +3,14 @@
 //! dispersive surfaces (thesis §2.4.1-2.4.2, pbrt-v4 §13.4).
 //!
 //! One walk serves the `path`, `spectral` and `auto` integrators:
-//! 0. intersect; a segment that reaches an absorbing dielectric from its
-//!    inside is attenuated by `exp(−σ t)` (Beer-Lambert);
+//! 0. intersect; a segment inside an absorbing medium (the current medium
+//!    of the path's medium stack, [`crate::bxdf::medium`]) is attenuated by
+//!    `exp(−σ t)` (Beer-Lambert);
 //! 1. at an emitter add `β · L_e`, MIS-weighted against light
 //!    sampling unless the previous bounce was delta (or this is the camera ray);
+//!    a false intersection of nested dielectrics is passed straight through
+//!    here (no bounce, no light sample); a real dielectric interface scatters
+//!    with the relative index against the medium outside it;
 //! 2. stop after `max_bounces` scattering events;
 //! 3. at a dispersive surface, when dispersion is on and the packet has more
 //!    than one wavelength, continue as `N` single-wavelength walks from this
@@ -24,7 +28,7 @@
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
-use crate::bxdf::{BsdfSample, Dispersion};
+use crate::bxdf::{BsdfSample, Dispersion, MediumStack};
 use crate::color::{N_BINS, Sampled};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
@@ -32,7 +36,7 @@ use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated};
 
-use super::{Shading, sample_direct};
+use super::{Interface, MAX_PASSES, Shading, absorption, interface, sample_direct};
 
 /// Bounces after which Russian roulette starts (Mitsuba's `rr_depth`).
 pub const RR_DEPTH: u32 = 5;
@@ -67,6 +71,8 @@ struct Walk<const N: usize> {
     eta_scale: f32,
     bounces: u32,
     prev: Prev,
+    /// The dielectric media the path is inside.
+    media: MediumStack,
 }
 
 impl PathTracer {
@@ -86,6 +92,7 @@ impl PathTracer {
             eta_scale: 1.0,
             bounces: 0,
             prev: Prev { p: ray.origin, pdf_bsdf: 0.0, delta: true },
+            media: scene.camera_media,
         };
         self.walk(scene, ray, si, walk, lambdas, sampler, Start::Camera)
     }
@@ -105,15 +112,13 @@ impl PathTracer {
         let mut l = Sampled::<N>::splat(0.0);
         let mut split = O::default();
         let mut add_emission = start == Start::Camera;
+        let mut passes = 0;
         loop {
             let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
-            // 0. Beer-Lambert absorption along a segment inside an absorbing
-            //    dielectric (once: a split walk starts at a hit already counted).
-            if add_emission
-                && let Some(sigma) = scene.materials[object.material as usize].absorption()
-                && ray.dir.dot(hit.n) > 0.0
-            {
+            // 0. Beer-Lambert absorption along the segment, in the medium it ran
+            //    in (once: a split walk starts at a hit already counted).
+            if add_emission && let Some(sigma) = absorption(scene, w.media.current()) {
                 w.beta *= (lambdas.sample(sigma) * -hit.t).exp();
             }
             // 1. Emission, MIS-weighted against the light sample taken at the previous vertex.
@@ -131,6 +136,22 @@ impl PathTracer {
                 }
             }
             add_emission = true;
+            // Nested dielectrics: a false intersection goes straight on.
+            let at = interface(scene, &mut w.media, &si, ray.dir);
+            if let Interface::Pass = at {
+                // Shadow rays stop at every surface, so light sampling never
+                // reaches past a false intersection: the BSDF sample there
+                // carries the full weight at an emitter beyond (no MIS).
+                w.prev.delta = true;
+                passes += 1;
+                ray = Ray::spawn(hit.p, hit.n, ray.dir);
+                match scene.intersect(&ray, f32::INFINITY) {
+                    Some(next) if passes <= MAX_PASSES => si = next,
+                    _ => break,
+                }
+                continue;
+            }
+            passes = 0;
             // 2. Depth limit.
             if w.bounces >= self.max_bounces {
                 break;
@@ -142,7 +163,7 @@ impl PathTracer {
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             // 3. A dispersive surface splits the packet into single wavelengths.
             let mut reflect = None;
-            let dispersion = if self.disperse { bxdf.dispersion() } else { None };
+            let dispersion = if self.disperse { bxdf.dispersion_within(at.outside()) } else { None };
             if N > 1
                 && let Some(dispersion) = dispersion
             {
@@ -177,7 +198,8 @@ impl PathTracer {
             }
             // 4. Direct light.
             if !bxdf.is_delta() {
-                l += w.beta * sample_direct(scene, bxdf, &sh, lambdas, sampler, true);
+                let surround = at.surround(scene, &w.media);
+                l += w.beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, true);
             }
             // 5. The next direction.
             let u = sampler.next_2d();
@@ -185,7 +207,7 @@ impl PathTracer {
             let sample = match (reflect.take(), std::mem::replace(&mut start, Start::Camera), dispersion) {
                 (Some(weight), ..) => Some(mirror(sh.wo, weight)),
                 (None, Start::SplitRefraction, Some(d)) => refraction(d, sh.wo, lambdas),
-                _ => bxdf.sample(sh.wo, u, uc, lambdas),
+                _ => bxdf.sample_within(sh.wo, u, uc, lambdas, at.outside()),
             };
             let Some(bs) = sample else {
                 break;
@@ -194,6 +216,7 @@ impl PathTracer {
             if !sh.consistent(wi, bs.wi) {
                 break;
             }
+            at.scattered(&mut w.media, ray.dir, hit.n, wi);
             w.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
             w.eta_scale *= bs.eta * bs.eta;
             w.bounces += 1;
@@ -324,5 +347,5 @@ fn refraction<const N: usize>(d: Dispersion<'_>, wo: glam::Vec3, lambdas: &Lambd
 /// The packet-independent part of a walk's state, for a split.
 #[inline]
 fn copy_walk<const N: usize>(w: &Walk<N>) -> Walk<1> {
-    Walk { beta: Sampled([0.0]), eta_scale: w.eta_scale, bounces: w.bounces, prev: w.prev }
+    Walk { beta: Sampled([0.0]), eta_scale: w.eta_scale, bounces: w.bounces, prev: w.prev, media: w.media }
 }

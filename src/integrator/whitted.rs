@@ -7,7 +7,9 @@
 //! Indirect diffuse light and caustics are missing by construction: that is the
 //! method's documented shortfall, not a bug. Rough metals and rough glass are
 //! not specular: they end the chain like a diffuse surface (direct light
-//! only). Absorbing glass attenuates the chain's segments inside it. Dispersive glass refracts every
+//! only). Nested dielectrics follow the path's medium stack as in `path`
+//! (false intersections passed, relative indices, absorption by the medium
+//! each segment runs in). Dispersive glass refracts every
 //! wavelength like 589.3 nm (no rainbow), as in the `path` integrator: its
 //! packets are the full spectrum, which a BxDF samples at that wavelength.
 
@@ -17,7 +19,7 @@ use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
 
-use super::{Shading, sample_direct};
+use super::{Interface, MAX_PASSES, Shading, absorption, interface, sample_direct};
 
 /// The Whitted integrator.
 #[derive(Clone, Copy, Debug)]
@@ -38,13 +40,13 @@ impl Whitted {
         let mut l = Sampled::<N>::splat(0.0);
         let mut beta = Sampled::<N>::splat(1.0);
         let mut bounces = 0;
+        let mut media = scene.camera_media;
+        let mut passes = 0;
         while let Some(si) = scene.intersect(&ray, f32::INFINITY) {
             let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
-            // Beer-Lambert absorption along a segment inside an absorbing dielectric.
-            if let Some(sigma) = scene.materials[object.material as usize].absorption()
-                && ray.dir.dot(hit.n) > 0.0
-            {
+            // Beer-Lambert absorption along the segment, in the medium it ran in.
+            if let Some(sigma) = absorption(scene, media.current()) {
                 beta *= (lambdas.sample(sigma) * -hit.t).exp();
             }
             // Emitters seen directly or through specular surfaces only.
@@ -52,6 +54,17 @@ impl Whitted {
                 let light = &scene.lights[index as usize];
                 l += beta * lambdas.sample(light.spectrum()) * light.le_scale(hit.n, ray.dir);
             }
+            // Nested dielectrics: a false intersection goes straight on.
+            let at = interface(scene, &mut media, &si, ray.dir);
+            if let Interface::Pass = at {
+                passes += 1;
+                if passes > MAX_PASSES {
+                    break;
+                }
+                ray = Ray::spawn(hit.p, hit.n, ray.dir);
+                continue;
+            }
+            passes = 0;
             if bounces >= self.max_bounces {
                 break;
             }
@@ -62,18 +75,19 @@ impl Whitted {
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             if !bxdf.is_delta() {
                 // The diffuse end of E S* D L: direct light only, then stop.
-                l += beta * sample_direct(scene, bxdf, &sh, lambdas, sampler, false);
+                l += beta * sample_direct(scene, bxdf, &sh, at.surround(scene, &media), lambdas, sampler, false);
                 break;
             }
             let u = sampler.next_2d();
             let uc = sampler.next_1d();
-            let Some(bs) = bxdf.sample(sh.wo, u, uc, lambdas) else {
+            let Some(bs) = bxdf.sample_within(sh.wo, u, uc, lambdas, at.outside()) else {
                 break;
             };
             let wi = sh.frame.to_world(bs.wi);
             if !sh.consistent(wi, bs.wi) {
                 break;
             }
+            at.scattered(&mut media, ray.dir, hit.n, wi);
             beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
             bounces += 1;
             ray = Ray::spawn(hit.p, hit.n, wi);

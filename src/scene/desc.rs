@@ -186,7 +186,7 @@ pub enum MaterialDesc {
         /// Absorption coefficient inside, per scene unit (default: clear).
         #[serde(default)]
         absorption: Option<SpectrumDesc>,
-        /// A thin film on the outside (smooth glass only): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
+        /// A thin film on the outside (on every microfacet of rough glass): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
         #[serde(default)]
         coating: Option<CoatingDesc>,
     },
@@ -340,6 +340,11 @@ pub struct ObjectDesc {
     /// only the side the normal points to, outward for a sphere).
     #[serde(default)]
     pub two_sided: bool,
+    /// For a dielectric object: which medium wins where its volume overlaps
+    /// another's (default 0; higher wins; nested dielectrics, see
+    /// [`crate::bxdf::medium`]; ignored for other materials): `priority: 2`.
+    #[serde(default)]
+    pub priority: u32,
 }
 
 /// A light that is not an object.

@@ -208,12 +208,6 @@ impl Ctx<'_> {
                     d = d.with_absorption(self.spectrum(&format!("{field}.absorption"), a)?);
                 }
                 if let Some(CoatingDesc::ThinFilm { thickness_nm, ior }) = coating {
-                    if !d.is_smooth() {
-                        return Err(self.err(
-                            format!("{field}.coating"),
-                            "a coating is supported on smooth glass only (roughness below 0.001)",
-                        ));
-                    }
                     d = d.with_coating(self.thin_film(&format!("{field}.coating"), *thickness_nm, ior)?);
                 }
                 Bxdf::Dielectric(d)
@@ -423,7 +417,7 @@ fn build(ctx: &Ctx<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<Sc
                 Some(lights.len() as u32 - 1)
             }
         };
-        objects.push(Object { shape, material, light });
+        objects.push(Object { shape, material, light, priority: o.priority });
     }
     for (i, l) in desc.lights.iter().enumerate() {
         match l {

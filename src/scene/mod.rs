@@ -13,7 +13,7 @@ mod spectra;
 
 pub use load::{load_scene, load_scene_str};
 
-use crate::bxdf::Bxdf;
+use crate::bxdf::{Bxdf, Medium, MediumStack};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::light::Light;
@@ -37,6 +37,9 @@ pub struct Object {
     pub material: u32,
     /// Index into [`Scene::lights`] when the object emits.
     pub light: Option<u32>,
+    /// Where dielectric volumes overlap, the higher priority wins (nested
+    /// dielectrics, [`crate::bxdf::medium`]).
+    pub priority: u32,
 }
 
 /// The closest hit of a ray in the scene.
@@ -62,6 +65,9 @@ pub struct Scene {
     light_cdf: Vec<f32>,
     /// The camera.
     pub camera: Camera,
+    /// The dielectric media the camera's eye is inside, where every camera
+    /// path starts ([`Scene::camera_media`]).
+    pub camera_media: MediumStack,
     /// Render settings: the file's `render` block with command-line overrides applied.
     pub settings: Settings,
     /// Indices of bounded objects, in the BVH's order when there is one.
@@ -106,6 +112,7 @@ impl Scene {
         for l in &mut lights {
             l.set_scene_bounds(world.centroid(), radius);
         }
+        let camera_media = media_at(camera.eye(), &objects, &materials);
         let bvh = (bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);
             bounded = bvh.prim_order().iter().map(|&k| bounded[k as usize]).collect();
@@ -133,6 +140,7 @@ impl Scene {
             light_pmf,
             light_cdf,
             camera,
+            camera_media,
             settings,
             bounded,
             unbounded,
@@ -198,6 +206,36 @@ impl Scene {
         Some((i, self.light_pmf[i]))
     }
 
+    /// The medium of object `object` when its material is a dielectric.
+    #[inline]
+    pub fn medium(&self, object: u32) -> Option<Medium> {
+        let o = &self.objects[object as usize];
+        self.materials[o.material as usize].as_dielectric()?;
+        Some(Medium { object, priority: o.priority, material: o.material })
+    }
+
+    /// True when dielectric media may nest or overlap, so that a path needs
+    /// the medium stack: the camera starts inside a dielectric, or two
+    /// dielectric objects' bounds overlap (an unbounded one overlaps all).
+    /// `bdpt` and `lighttrace` have no medium stack (`auto` avoids them here).
+    pub fn has_nested_media(&self) -> bool {
+        if !self.camera_media.is_empty() {
+            return true;
+        }
+        let glass: Vec<Option<Aabb>> = self
+            .objects
+            .iter()
+            .filter(|o| self.materials[o.material as usize].as_dielectric().is_some())
+            .map(|o| o.shape.bounds())
+            .collect();
+        glass.iter().enumerate().any(|(i, a)| {
+            glass[i + 1..].iter().any(|b| match (a, b) {
+                (Some(a), Some(b)) => a.min.cmple(b.max).all() && b.min.cmple(a.max).all(),
+                _ => true,
+            })
+        })
+    }
+
     /// True when any material's direction depends on wavelength.
     pub fn has_dispersion(&self) -> bool {
         self.objects.iter().any(|o| self.materials[o.material as usize].is_dispersive())
@@ -206,5 +244,89 @@ impl Scene {
     /// The number of objects.
     pub fn object_count(&self) -> usize {
         self.objects.len()
+    }
+}
+
+/// Directions that probe whether a point is inside a closed object: the six
+/// axes, turned off them so that no probe runs along a face of a box.
+const PROBES: [[f32; 3]; 6] = [
+    [0.8, 0.35, 0.48],
+    [-0.8, -0.35, -0.48],
+    [0.3, 0.9, -0.31],
+    [-0.3, -0.9, 0.31],
+    [-0.42, 0.27, 0.87],
+    [0.42, -0.27, -0.87],
+];
+
+/// The dielectric media a point is inside, the outermost first, as a
+/// camera path starts there. For each dielectric object, six rays from `p`
+/// find the object's nearest surface: `p` is inside when more of the probes
+/// that hit leave the object (along its outward normal) than enter it, which
+/// works for solids and half-spaces (planes) and outvotes a hole or a grazing
+/// edge. Among the objects found, the one whose surface is farthest is the
+/// outermost, entered first (so equal priorities nest by geometry: a camera
+/// in water inside glass is in the water).
+fn media_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> MediumStack {
+    let mut found: Vec<(f32, Medium)> = Vec::new();
+    for (i, o) in objects.iter().enumerate() {
+        if materials[o.material as usize].as_dielectric().is_none() {
+            continue;
+        }
+        let (mut leave, mut enter, mut nearest) = (0, 0, f32::INFINITY);
+        for d in PROBES {
+            let ray = Ray::new(p, glam::Vec3::from(d).normalize());
+            if let Some(hit) = o.shape.intersect(&ray, f32::INFINITY) {
+                if ray.dir.dot(hit.n) > 0.0 {
+                    leave += 1;
+                    nearest = nearest.min(hit.t);
+                } else {
+                    enter += 1;
+                }
+            }
+        }
+        if leave > enter {
+            found.push((nearest, Medium { object: i as u32, priority: o.priority, material: o.material }));
+        }
+    }
+    found.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut stack = MediumStack::VACUUM;
+    for (_, m) in found {
+        stack.enter(m);
+    }
+    stack
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::settings::SettingsPatch;
+
+    fn camera_media(eye: &str, objects: &str) -> Vec<u32> {
+        let text = format!(
+            r#"(camera: (eye: {eye}, look_at: (0.1, 0.2, -3), fov_deg: 30),
+            materials: {{ "glass": Dielectric(ior: Constant(1.5)), "white": Lambertian(reflectance: Constant(0.5)) }},
+            objects: [ {objects} ])"#
+        );
+        let scene = load_scene_str(&text, std::path::Path::new("t.ron"), &SettingsPatch::default()).unwrap();
+        scene.camera_media.entries().iter().map(|m| m.object).collect()
+    }
+
+    /// The camera's starting media: inside a solid (outermost first, by
+    /// distance), below a glass half-space, not in a bubble's cavity, not in
+    /// a diffuse object, not outside.
+    #[test]
+    fn the_camera_starts_in_the_media_around_its_eye() {
+        let nested = r#"(shape: Sphere(center: (0, 0, 0), radius: 0.5), material: "glass"),
+            (shape: Cuboid(min: (-2, -2, -2), max: (2, 2, 2)), material: "glass"),
+            (shape: Sphere(center: (0, 0, 0), radius: 1), material: "white")"#;
+        assert_eq!(camera_media("(0, 0, 0)", nested), [1, 0]);
+        assert_eq!(camera_media("(0, 1.5, 0)", nested), [1]);
+        assert_eq!(camera_media("(0, 3, 0)", nested), Vec::<u32>::new());
+        let plane = r#"(shape: Plane(point: (0, 1, 0), normal: (0, 1, 0)), material: "glass")"#;
+        assert_eq!(camera_media("(0, 0, 0)", plane), [0]);
+        assert_eq!(camera_media("(0, 2, 0)", plane), Vec::<u32>::new());
+        let bubble = r#"(shape: Bubble(center: (0, 0, 0), outer_radius: 1, inner_radius: 0.9), material: "glass")"#;
+        assert_eq!(camera_media("(0, 0, 0)", bubble), Vec::<u32>::new());
+        assert_eq!(camera_media("(0, 0.95, 0)", bubble), [0]);
     }
 }

@@ -4,7 +4,7 @@
 //! documented shortfall, and never NaN or infinity (`render_str` asserts that
 //! every sample is finite). Images are 8x8 to 16x16; tolerances are stated
 //! at each test. This file holds the shared helpers and the analytic scenes;
-//! [`glass`] the dielectric and caustic cases, [`surfaces`] indirect light,
+//! [`glass`] the dielectric and caustic cases, [`nested`] nested dielectrics, [`surfaces`] indirect light,
 //! grazing angles, coincident surfaces, meshes, scales and bright lights.
 
 use rust_v::film::Film;
@@ -13,6 +13,7 @@ use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 mod glass;
 mod lighttrace;
 mod materials;
+mod nested;
 mod surfaces;
 
 use crate::common::{mean_and_stderr, render_str, temp_dir};
