@@ -77,7 +77,7 @@ impl Camera {
     #[inline]
     pub fn project(&self, dir: Vec3) -> Option<Vec2> {
         let z = dir.dot(self.forward);
-        if !(z > 0.0) {
+        if z.is_nan() || z <= 0.0 {
             return None;
         }
         let sx = dir.dot(self.right) / z;

@@ -263,7 +263,14 @@ impl Estimator for Bdpt {
 
 impl Bdpt {
     /// The eye and the walk of the pixel ray.
-    fn camera_subpath(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, path: &mut Vec<Vertex>, wl: &mut Wavelength) {
+    fn camera_subpath(
+        &self,
+        scene: &Scene,
+        film: Vec2,
+        sampler: &mut Sampler,
+        path: &mut Vec<Vertex>,
+        wl: &mut Wavelength,
+    ) {
         let cam = &scene.camera;
         let ray = cam.ray(film);
         path.push(Vertex::at_point(Kind::Camera, ray.origin, cam.forward(), Spectrum::ONE, 1.0));
@@ -317,7 +324,7 @@ impl Bdpt {
         let eye = cam.eye();
         let to_eye = eye - qs.p();
         let d2 = to_eye.length_squared();
-        if !(d2 > 0.0) {
+        if d2.is_nan() || d2 <= 0.0 {
             return None;
         }
         let w = to_eye / d2.sqrt();
@@ -335,7 +342,7 @@ impl Bdpt {
                     return None;
                 }
                 let e = emit_factor(light, qs.sh.n, w) * importance;
-                if !(e > 0.0) {
+                if e.is_nan() || e <= 0.0 {
                     return None;
                 }
                 if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
@@ -433,7 +440,7 @@ impl Bdpt {
                     return NONE;
                 };
                 let wi = pt.sh.frame.to_local(ls.wi);
-                if !pt.sh.consistent(ls.wi, wi) || !(ls.pdf > 0.0) {
+                if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
                 }
                 let bxdf = material(scene, object);
@@ -472,7 +479,7 @@ impl Bdpt {
                 };
                 let d = qs.p() - pt.p();
                 let d2 = d.length_squared();
-                if !(d2 > 0.0) {
+                if d2.is_nan() || d2 <= 0.0 {
                     return NONE;
                 }
                 let w = d / d2.sqrt();
@@ -489,7 +496,9 @@ impl Bdpt {
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
                 } else {
                     let full = Lambdas::full();
-                    Contrib::Full(pt.beta * bp.eval(pt.sh.wo, wi_p, &full) * bq.eval(wi_q, qs.sh.wo, &full) * qs.beta * k)
+                    Contrib::Full(
+                        pt.beta * bp.eval(pt.sh.wo, wi_p, &full) * bq.eval(wi_q, qs.sh.wo, &full) * qs.beta * k,
+                    )
                 };
                 if is_black(&c) {
                     return NONE;
@@ -502,8 +511,7 @@ impl Bdpt {
                 let ptm_rev = pdf_vertex(scene, pt, qs.p(), ptm);
                 let qs_rev = pdf_vertex(scene, pt, ptm.p(), qs);
                 let qsm_rev = pdf_vertex(scene, qs, pt.p(), &light[s - 2]);
-                let weight =
-                    mis_weight(scene, camera, t, light, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
+                let weight = mis_weight(scene, camera, t, light, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
                 scale(c, weight, attenuation(scene, pt, qs.p()), wl)
             }
         }
@@ -575,9 +583,16 @@ impl Walk {
             }
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             let prev = *path.last().expect("a subpath starts at the eye or a light");
-            let mut v = Vertex { kind: Kind::Surface(si.object), sh, beta, delta: false, collapsed, pdf_fwd: 0.0, pdf_rev: 0.0 };
-            v.pdf_fwd =
-                if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, &prev, &v) };
+            let mut v = Vertex {
+                kind: Kind::Surface(si.object),
+                sh,
+                beta,
+                delta: false,
+                collapsed,
+                pdf_fwd: 0.0,
+                pdf_rev: 0.0,
+            };
+            v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, &prev, &v) };
             parallel = false;
             path.push(v);
             if path.len() >= self.max_vertices || bxdf.is_black() {
@@ -606,7 +621,7 @@ impl Walk {
                 break;
             };
             let wi = sh.frame.to_world(bs.wi);
-            if !sh.consistent(wi, bs.wi) || !(bs.pdf > 0.0) {
+            if !sh.consistent(wi, bs.wi) || bs.pdf.is_nan() || bs.pdf <= 0.0 {
                 break;
             }
             let mut weight = bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -627,7 +642,7 @@ impl Walk {
             bounces += 1;
             if bounces >= RR_DEPTH {
                 let q = (beta.max_value() / beta_ref).min(0.95);
-                if !(sampler.next_1d() < q) {
+                if sampler.next_1d() >= q || q.is_nan() {
                     break;
                 }
                 beta /= q;
@@ -694,7 +709,7 @@ fn attenuation(scene: &Scene, v: &Vertex, to: Vec3) -> Spectrum {
 fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -> f32 {
     let d = to.p() - from.p();
     let d2 = d.length_squared();
-    if !(d2 > 0.0) {
+    if d2.is_nan() || d2 <= 0.0 {
         return 0.0;
     }
     let mut pdf = pdf_dir / d2;

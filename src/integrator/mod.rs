@@ -54,8 +54,13 @@ pub(crate) trait Estimator: Sync {
     /// The estimate of one sample through film position `film` (pixel units): its XYZ, or its
     /// per-bin radiance for spectral output. Light subpaths connected to the camera land in
     /// whatever pixel they reach: those contributions go to `splats`.
-    fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, splats: &mut Vec<Splat<O>>)
-    -> O;
+    fn sample<O: Contribution>(
+        &self,
+        scene: &Scene,
+        film: Vec2,
+        sampler: &mut Sampler,
+        splats: &mut Vec<Splat<O>>,
+    ) -> O;
 }
 
 /// The light-transport method, with its bounce limit.

@@ -134,9 +134,7 @@ impl Light {
             Light::Sphere(l) => {
                 (1.0 / (4.0 * PI * l.sphere.radius * l.sphere.radius), surface_pdf_dir(n, dir, l.two_sided))
             }
-            Light::Disk(l) => {
-                (1.0 / (PI * l.disk.radius * l.disk.radius), surface_pdf_dir(n, dir, l.two_sided))
-            }
+            Light::Disk(l) => (1.0 / (PI * l.disk.radius * l.disk.radius), surface_pdf_dir(n, dir, l.two_sided)),
             Light::Area(l) => (1.0 / l.area(), surface_pdf_dir(n, dir, l.two_sided)),
             Light::Distant(l) => (1.0 / (PI * l.scene_radius * l.scene_radius), 1.0),
             Light::Beam(l) => (1.0 / (PI * l.radius * l.radius), 1.0),
@@ -147,7 +145,7 @@ impl Light {
 /// A cosine-distributed ray from a point of an area light.
 #[inline]
 fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Option<EmissionSample> {
-    if !(area > 0.0) {
+    if area.is_nan() || area <= 0.0 {
         return None;
     }
     let (side, u, pick) = if !two_sided {
@@ -181,7 +179,7 @@ fn surface_pdf_dir(n: Vec3, dir: Vec3, two_sided: bool) -> f32 {
 /// A ray of a collimated disk of radius `r` centred at `center`, travelling along `dir`.
 #[inline]
 fn parallel_ray(center: Vec3, dir: Vec3, r: f32, u: Vec2) -> Option<EmissionSample> {
-    if !(r > 0.0) {
+    if r.is_nan() || r <= 0.0 {
         return None;
     }
     let q = concentric_disk(u) * r;
@@ -227,7 +225,8 @@ mod tests {
             let mut sum = 0.0f64;
             for _ in 0..n {
                 let Some(e) = light.sample_le(s.next_2d(), s.next_2d()) else { continue };
-                let cos = if light.is_delta_position() || light.is_delta_direction() { 1.0 } else { e.dir.dot(e.n).abs() };
+                let cos =
+                    if light.is_delta_position() || light.is_delta_direction() { 1.0 } else { e.dir.dot(e.n).abs() };
                 sum += (e.scale * cos / (e.pdf_pos * e.pdf_dir)) as f64;
                 let (pp, pd) = light.pdf_le(e.n, e.dir);
                 assert!((pp - e.pdf_pos).abs() <= 1e-5 * pp && (pd - e.pdf_dir).abs() <= 1e-4 * pd, "{light:?}");

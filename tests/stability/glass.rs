@@ -251,7 +251,8 @@ fn caustic_from_a_delta_light_is_exactly_zero() {
         }
     }
     // The point light's caustic: BDPT, light tracing and BDPT with a small sphere light of equal power.
-    let point = scene.replace("],\n    )", "],\n        lights: [ Point(position: (0, 1.5, 0), intensity: Constant(2)) ],\n    )");
+    let point = scene
+        .replace("],\n    )", "],\n        lights: [ Point(position: (0, 1.5, 0), intensity: Constant(2)) ],\n    )");
     let bdpt = render_str(&point, &method("bdpt", 256, 21));
     let light = render_str(&point, &method("lighttrace", 256, 22));
     let (b, bs) = region_mean(&bdpt);
@@ -261,9 +262,12 @@ fn caustic_from_a_delta_light_is_exactly_zero() {
         y(&bdpt).iter().zip(y(&light)).zip(&shadow).filter(|(_, s)| **s).map(|((a, b), _)| a - b).collect();
     let (d, ds) = mean_se(&diff);
     assert!(d.abs() < 5.0 * ds, "bdpt - lighttrace = {d} ± {ds}");
-    let (sphere_scene, _) = caustic_scene("(shape: Sphere(center: (0, 1.5, 0), radius: 0.05), emission: Constant(254.65)),");
+    let (sphere_scene, _) =
+        caustic_scene("(shape: Sphere(center: (0, 1.5, 0), radius: 0.05), emission: Constant(254.65)),");
     let (q, qs) = region_mean(&render_str(&sphere_scene, &method("bdpt", 256, 23)));
-    eprintln!("point-light caustic: bdpt {b:.4} ± {bs:.4}, lighttrace {l:.4} ± {ls:.4}, sphere light (bdpt) {q:.4} ± {qs:.4}");
+    eprintln!(
+        "point-light caustic: bdpt {b:.4} ± {bs:.4}, lighttrace {l:.4} ± {ls:.4}, sphere light (bdpt) {q:.4} ± {qs:.4}"
+    );
     assert!((b - q).abs() < 5.0 * (bs * bs + qs * qs).sqrt(), "point {b} vs sphere light {q}");
 }
 

@@ -82,7 +82,9 @@ fn lighttrace_grazing_view_of_a_diffuse_plane() {
     let v = y(&render_str(&scene, &method("lighttrace", 256, 16)));
     let (plane, se) = mean_se(&v[40..]);
     let (sky, se_sky) = mean_se(&v[..32]);
-    eprintln!("grazing diffuse, lighttrace: plane Y = {plane:.4} ± {se:.4} (want 0.5), sky {sky:.4} ± {se_sky:.4} (want 1)");
+    eprintln!(
+        "grazing diffuse, lighttrace: plane Y = {plane:.4} ± {se:.4} (want 0.5), sky {sky:.4} ± {se_sky:.4} (want 1)"
+    );
     assert!(plane < 0.5, "plane {plane} ± {se}");
     assert!((sky - 1.0).abs() < 5.0 * se_sky + 0.02, "sky {sky} ± {se_sky}");
 }

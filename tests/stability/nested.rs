@@ -282,7 +282,10 @@ fn bdpt_has_no_medium_stack() {
     eprintln!("nested, camera in water, bdpt: Y = {mean:.4} ± {se:.4} (no stack: {want:.4})");
     assert!((mean - want).abs() < 5.0 * se + 1e-3 * want, "bdpt: {mean} ± {se}");
     // With a point light and glass `auto` would pick BDPT, but not where media nest.
-    let lit = format!("{}], lights: [ Point(position: (0, 3, 0), intensity: Constant(1)) ])", scene.trim_end().trim_end_matches("])"));
+    let lit = format!(
+        "{}], lights: [ Point(position: (0, 3, 0), intensity: Constant(1)) ])",
+        scene.trim_end().trim_end_matches("])")
+    );
     let loaded = rust_v::scene::load_scene_str(&lit, std::path::Path::new("t.ron"), &Default::default()).unwrap();
     assert!(loaded.has_nested_media());
     let said = rust_v::integrator::describe(&loaded);
