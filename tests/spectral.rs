@@ -4,7 +4,7 @@
 use rust_v::film::Film;
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
-use crate::common::{mean_and_stderr, render_str, root};
+use crate::common::{mean_and_stderr, render_str, render_str_bins, root};
 
 /// Film columns at which scripts/prism_geometry.py (an independent 2-D f64
 /// tracer with the N-SF11 Sellmeier equation) predicts each wavelength's image
@@ -24,8 +24,9 @@ fn overrides(integrator: IntegratorKind, wavelengths: WavelengthsKind, spp: u32,
 
 /// The light emits in one 10 nm bin only; the centroid of the image must sit
 /// at the predicted column within 1.5 px (the light's image is ~2 px wide and
-/// the bin centre wavelength is exact), and shorter wavelengths deviate more
-/// (appear further right).
+/// the bin centre wavelength is exact: a spectral film keeps single-wavelength
+/// paths at the bin centres), and shorter wavelengths deviate more (appear
+/// further right).
 #[test]
 fn prism_images_sit_where_snell_puts_them() {
     let text = std::fs::read_to_string(root().join("scenes/prism.ron")).unwrap();
@@ -36,7 +37,7 @@ fn prism_images_sit_where_snell_puts_them() {
         let scene = text
             .replace("Scaled(50, EqualEnergy)", &format!("Samples([{}])", samples.join(", ")))
             .replace("\"../meshes/prism.obj\"", &format!("\"{}\"", root().join("meshes/prism.obj").display()));
-        let film = render_str(&scene, &overrides(IntegratorKind::Spectral, WavelengthsKind::Hero, 16, 1));
+        let film = render_str_bins(&scene, &overrides(IntegratorKind::Spectral, WavelengthsKind::Hero, 16, 1));
         let (col, total) = centroid_column(&film);
         assert!(total > 0.0, "{lambda} nm: no image of the light");
         assert!((col - want).abs() < 1.5, "{lambda} nm: image at column {col:.2}, Snell says {want:.2}");
@@ -233,18 +234,11 @@ fn whitted_matches_path_on_specular_only_scenes() {
 /// Renders `scenes/prism-slit.ron` with `auto` at `spp`: continuous wavelengths for a colour
 /// film, or the 36 bin centres when the film is spectral (what `--spectral` output keeps).
 fn prism_slit(spp: u32, bins: bool) -> Film {
-    use rust_v::render::{Limits, render};
     let text = std::fs::read_to_string(root().join("scenes/prism-slit.ron")).unwrap();
     let text = text.replace("\"../meshes/prism.obj\"", &format!("\"{}\"", root().join("meshes/prism.obj").display()));
     // Two refractions reach the slit; internal reflections (faint ghosts) are left out.
     let o = SettingsPatch { spp: Some(spp), seed: Some(3), max_bounces: Some(2), ..Default::default() };
-    let scene = rust_v::scene::load_scene_str(&text, std::path::Path::new("prism-slit.ron"), &o).unwrap();
-    let (w, h) = (scene.settings.width, scene.settings.height);
-    let mut film = if bins { Film::new_spectral(w, h, 0) } else { Film::new(w, h) };
-    let stop = std::sync::atomic::AtomicBool::new(false);
-    let stats = render(&scene, &mut film, 0..spp, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
-    assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
-    film
+    if bins { render_str_bins(&text, &o) } else { render_str(&text, &o) }
 }
 
 /// Per image column: luminance Y summed over the rows, and the hue angle in degrees of the
