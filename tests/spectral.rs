@@ -145,7 +145,10 @@ pub(crate) fn assert_same_image(a: &[(f64, f64)], b: &[(f64, f64)], what: &str) 
     }
 }
 
-/// Without dispersion, path, hero and random packets estimate the same image.
+/// Without dispersion, path, hero and random packets estimate the same image, and so do
+/// continuous packets (`--wavelengths continuous`: they multiply the interpolated spectra at
+/// each wavelength where the bins interpolate products, a difference of second order in the
+/// bin spacing, about 0.2% in the saturated walls, far below the 6 standard errors here).
 #[test]
 fn spectral_samplers_agree_with_path_without_dispersion() {
     let scene = std::fs::read_to_string(root().join("scenes/cornell-lambert.ron")).unwrap();
@@ -155,8 +158,10 @@ fn spectral_samplers_agree_with_path_without_dispersion() {
     let path = block_stats(&scene, o(IntegratorKind::Path, WavelengthsKind::Hero), 8, 4);
     let hero = block_stats(&scene, o(IntegratorKind::Spectral, WavelengthsKind::Hero), 8, 4);
     let random = block_stats(&scene, o(IntegratorKind::Spectral, WavelengthsKind::Random), 8, 4);
+    let continuous = block_stats(&scene, o(IntegratorKind::Spectral, WavelengthsKind::Continuous), 8, 4);
     assert_same_image(&path, &hero, "path vs hero");
     assert_same_image(&path, &random, "path vs random");
+    assert_same_image(&path, &continuous, "path vs continuous");
 }
 
 /// With dispersion (nine N-SF11 spheres), hero and random packets converge

@@ -250,7 +250,13 @@ impl PathTracer {
     /// throughput × [`bin_importance`], each weighted `1 / (C · p(bin))`,
     /// each refracting at its own index as a single-wavelength walk of
     /// throughput `β(λ) (1 − F(λ)) / (1 − P_r)` whose colour is added to
-    /// `split`. Returns `None` after a collapse (or a dead path).
+    /// `split`. For colour output each wavelength is then placed
+    /// continuously within its bin's tent ([`for_each_rotated_continuous`],
+    /// weight `1 / (C · p(λ))`), `β(λ)` interpolated between bins and `F`
+    /// and the index taken at λ exactly; `P_r` is then at most
+    /// `1 − 2⁻¹⁰`, since wavelengths beyond the last bin may refract where
+    /// every bin is totally reflected. Returns `None` after a collapse (or a
+    /// dead path).
     ///
     /// Any `P_r` that is below 1 wherever some wavelength is transmitted keeps
     /// this unbiased. Arriving from outside (always, unless the camera or an
