@@ -103,7 +103,7 @@ pub fn continuous_wavelength(select: &BinDistribution, u: f32) -> (Lambdas<1>, f
     let (bin, v) = select.sample_with_remainder(u);
     let mut lambda = sample_tent(bin, v);
     let mut p = continuous_density(select, lambda);
-    if !(p > 0.0) {
+    if p.is_nan() || p <= 0.0 {
         lambda = bin_nm(bin);
         p = continuous_density(select, lambda);
     }
