@@ -16,8 +16,8 @@ matrix (rust-v uses the same one).
 Regions and standard errors as scripts/cornell_regions.py (imported from there).
 
 Usage: scripts/mitsuba_weights.py OURS.exr [REF.exr] [CMF.csv]  (numpy and OpenEXR from PyPI)
-Prints a Markdown table: region, channel, rust-v, Mitsuba, difference (± one standard error),
-and the difference with Mitsuba's weights.
+Prints a Markdown table: region, channel, rust-v and Mitsuba means (linear sRGB), their relative
+difference, its standard error, the difference with Mitsuba's weights, and that in standard errors.
 """
 import os
 import sys
@@ -77,19 +77,18 @@ def main():
     w = mitsuba_weights(cmf_path)
     print(f"Mitsuba weights: flat spectrum Y = {w[:, 1].sum():.6f}", file=sys.stderr)
     mits = (bins @ w) @ XYZ_TO_SRGB.T
-    print("| region | channel | rust-v | Mitsuba | difference | with Mitsuba's weights |")
-    print("|---|---|---|---|---|---|")
+    print("| region | channel | rust-v | Mitsuba | difference | noise (1 s.e.) | with Mitsuba's weights | z |")
+    print("|---|---|---|---|---|---|---|---|")
     for name, idx in sorted(masks().items()):
         a, b, m = ours[idx], ref[idx], mits[idx]
         for c, cname in enumerate("RGB"):
             mb = b[:, c].mean()
-            cells = []
-            for x in (a, m):
-                rel = x[:, c].mean() / mb - 1
-                se = np.sqrt((x[:, c] - b[:, c]).var() / len(x)) / mb
-                cells.append(f"{100 * rel:+.2f}% ±{100 * se:.2f}")
-            print(f"| {name} | {cname} | {a[:, c].mean():.4f} | {mb:.4f} | {cells[0]} | {cells[1]} |")
-
+            rel, rel_m = a[:, c].mean() / mb - 1, m[:, c].mean() / mb - 1
+            # Pixel noise is independent: the spread of the per-pixel differences gives the
+            # standard error of the difference of the means (shading gradients cancel).
+            se = np.sqrt((a[:, c] - b[:, c]).var() / len(a)) / mb
+            print(f"| {name} | {cname} | {a[:, c].mean():.4f} | {mb:.4f} | {100 * rel:+.2f}% | "
+                  f"{100 * se:.2f}% | {100 * rel_m:+.2f}% | {rel_m / se:+.1f} |")
 
 if __name__ == "__main__":
     main()
