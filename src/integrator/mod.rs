@@ -146,7 +146,7 @@ pub fn describe(scene: &Scene) -> String {
     let dispersive = scene.has_dispersion();
     match s.integrator {
         IntegratorKind::Auto if dispersive => format!(
-            "auto: dispersive material present: full-spectrum path tracing; a path that refracts at dispersive glass continues as {} single wavelengths drawn by throughput and visual importance",
+            "auto: dispersive material present: full-spectrum path tracing; a path that refracts at dispersive glass continues as {} single continuous wavelengths (bin centres with --spectral) drawn by throughput and visual importance",
             s.packet_size
         ),
         IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),
@@ -160,7 +160,7 @@ pub fn describe(scene: &Scene) -> String {
                 s.packet_size
             ),
             w if dispersive => format!(
-                "spectral, {w:?} packets of {} continuous wavelengths (dispersive glass), split at dispersive surfaces",
+                "spectral, {w:?} packets of {} continuous wavelengths (dispersive glass; bin centres with --spectral), split at dispersive surfaces",
                 s.packet_size
             )
             .to_lowercase(),
