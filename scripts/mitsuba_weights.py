@@ -15,10 +15,17 @@ matrix (rust-v uses the same one).
 
 Regions and standard errors as scripts/cornell_regions.py (imported from there).
 
-Usage: scripts/mitsuba_weights.py OURS.exr [REF.exr] [CMF.csv]  (numpy and OpenEXR from PyPI)
+With --continuous CONT.exr (the same scene rendered with `--integrator spectral --wavelengths
+continuous`, which multiplies the interpolated spectra at each wavelength as Mitsuba does, instead
+of interpolating the per-bin products), a last column adds to CONT's region means the difference
+Mitsuba's weights make on OURS: Mitsuba's whole colour integral, up to third-order cross terms.
+
+Usage: scripts/mitsuba_weights.py OURS.exr [--continuous CONT.exr] [--ref REF.exr] [--cmf CMF.csv]
+(numpy and OpenEXR from PyPI)
 Prints a Markdown table: region, channel, rust-v and Mitsuba means (linear sRGB), their relative
 difference, its standard error, the difference with Mitsuba's weights, and that in standard errors.
 """
+import argparse
 import os
 import sys
 
@@ -68,17 +75,25 @@ def read_bins(path):
 
 
 def main():
-    ours_path = sys.argv[1]
-    ref_path = sys.argv[2] if len(sys.argv) > 2 else "../shared/peers/mitsuba/refs/cornell.exr"
-    cmf_path = sys.argv[3] if len(sys.argv) > 3 else "../shared/peers/mitsuba/cmf_mitsuba.csv"
-    ours = read_rgb(ours_path)
-    ref = read_rgb(ref_path)
-    bins = read_bins(ours_path)
-    w = mitsuba_weights(cmf_path)
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("ours", help="a --spectral EXR render of scenes/cornell-lambert.ron (256x256)")
+    ap.add_argument("--ref", default="../shared/peers/mitsuba/refs/cornell.exr")
+    ap.add_argument("--cmf", default="../shared/peers/mitsuba/cmf_mitsuba.csv")
+    ap.add_argument("--continuous", help="a render with --integrator spectral --wavelengths continuous: adds "
+                    "a column with its region means plus the CMF correction measured on OURS")
+    args = ap.parse_args()
+    ours, ref, bins = read_rgb(args.ours), read_rgb(args.ref), read_bins(args.ours)
+    cont = read_rgb(args.continuous) if args.continuous else None
+    w = mitsuba_weights(args.cmf)
     print(f"Mitsuba weights: flat spectrum Y = {w[:, 1].sum():.6f}", file=sys.stderr)
     mits = (bins @ w) @ XYZ_TO_SRGB.T
-    print("| region | channel | rust-v | Mitsuba | difference | noise (1 s.e.) | with Mitsuba's weights | z |")
-    print("|---|---|---|---|---|---|---|---|")
+    head = "| region | channel | rust-v | Mitsuba | difference | noise (1 s.e.) | with Mitsuba's weights | z |"
+    rule = "|---|---|---|---|---|---|---|---|"
+    if cont is not None:
+        head += " continuous λ + Mitsuba's weights | noise | z |"
+        rule += "---|---|---|"
+    print(head)
+    print(rule)
     for name, idx in sorted(masks().items()):
         a, b, m = ours[idx], ref[idx], mits[idx]
         for c, cname in enumerate("RGB"):
@@ -87,8 +102,16 @@ def main():
             # Pixel noise is independent: the spread of the per-pixel differences gives the
             # standard error of the difference of the means (shading gradients cancel).
             se = np.sqrt((a[:, c] - b[:, c]).var() / len(a)) / mb
-            print(f"| {name} | {cname} | {a[:, c].mean():.4f} | {mb:.4f} | {100 * rel:+.2f}% | "
-                  f"{100 * se:.2f}% | {100 * rel_m:+.2f}% | {rel_m / se:+.1f} |")
+            row = (f"| {name} | {cname} | {a[:, c].mean():.4f} | {mb:.4f} | {100 * rel:+.2f}% | "
+                   f"{100 * se:.2f}% | {100 * rel_m:+.2f}% | {rel_m / se:+.1f} |")
+            if cont is not None:
+                # The continuous render's products per wavelength, with the CMF table and constant
+                # corrected by the difference Mitsuba's weights make on the binned render.
+                k = cont[idx][:, c]
+                rel_k = (k.mean() + m[:, c].mean() - a[:, c].mean()) / mb - 1
+                se_k = np.sqrt((k - b[:, c]).var() / len(k)) / mb
+                row += f" {100 * rel_k:+.2f}% | {100 * se_k:.2f}% | {rel_k / se_k:+.1f} |"
+            print(row)
 
 if __name__ == "__main__":
     main()
