@@ -97,6 +97,9 @@ named_enum! {
         Random = "random",
         /// Three fixed wavelengths (435.8, 546.1, 700 nm) read out as RGB.
         Rgb = "rgb",
+        /// Hero packets at continuous wavelengths uniform over 360-830 nm in every scene, every
+        /// spectrum interpolated at each wavelength (as Mitsuba 3 and pbrt-v4 integrate colour).
+        Continuous = "continuous",
     }
 }
 

@@ -34,8 +34,71 @@
 //! visual importance ([`bin_importance`], [`BinDistribution`]), `C` of them
 //! by stratified rotation ([`for_each_rotated`]); each carries the weight
 //! `1 / (C · p(bin))`, which keeps every bin unbiased in the same way.
+//!
+//! # Continuous wavelengths
+//! Where a path follows single wavelengths after a dispersive split or
+//! collapse, 36 wavelengths would make a rainbow 36 separate images. There the
+//! wavelength is continuous over 360-830 nm ([`Readout::Continuous`]): the
+//! index of refraction is evaluated at λ exactly (Sellmeier, Cauchy, ...), and
+//! every spectrum the path meets is linearly interpolated at λ (flat beyond
+//! 380 and 730 nm: [`Lambdas::sample`] at a fractional position). A value `L`
+//! at λ adds `L · cmf(λ) · weight` to the pixel, with `cmf` the 1 nm CIE table
+//! linearly interpolated and divided by `∫ ȳ` ([`color::cmf_at`], the same
+//! function and normalisation as the weights `W_b`), and `weight = 1 / (C · p(λ))`
+//! for `C` draws of density `p` per nm.
+//!
+//! *The collapse draw* ([`continuous_wavelength`], any integrator may call it):
+//! bin `b` is chosen with probability `P_b` in proportion to throughput ×
+//! visual importance, as above; then λ is placed within bin `b`'s
+//! interpolation tent `φ_b` with density `φ_b(λ) / A_b`, `A_b = ∫ φ_b` (10 nm;
+//! 25 and 105 nm for the end bins, whose tents run flat to 360 and 830 nm).
+//! The density of λ is the mixture
+//!
+//! ```text
+//! p(λ) = Σ_b P_b · φ_b(λ) / A_b
+//! ```
+//!
+//! (between 380 and 730 nm, the linear interpolation of `P_b / 10`: in
+//! proportion to the interpolated throughput × importance). For any function
+//! `f`, `E[f(λ) / p(λ)] = ∫_{p > 0} f(λ) dλ`. `p(λ) = 0` only where every bin
+//! whose tent covers λ has `P_b = 0`, i.e. throughput 0 (the importance is
+//! positive everywhere); there the interpolated throughput `β(λ) = Σ_b β_b φ_b(λ)`
+//! is 0 and so is the path's radiance. Hence with `f = cmf · L`,
+//! `E[L(λ) · cmf(λ) / p(λ)] = ∫ cmf(λ) · L(λ) dλ` over 360-830 nm exactly, and
+//! each of `C` rotated draws (each of marginal density `p`) with weight
+//! `1 / (C · p(λ))` keeps the sum unbiased, as for bins.
+//!
+//! *The `spectral` integrator's packets* ([`sample_packet_continuous`]): in a
+//! scene with dispersive glass (and with `--wavelengths continuous`, in any
+//! scene) each of the `C` wavelengths is uniform over 360-830 nm, hero (equal
+//! rotation of the range) or independent: density `1/470` per nm each, weight
+//! `470 / C`, so `E[Σ_k L(λ_k) · cmf(λ_k) · 470 / C] = ∫ cmf · L`. They are
+//! continuous from the camera on, because a packet of `C` bins knows its
+//! throughput only at those bins: jittering a wavelength at the split would
+//! need the throughput between bins, which the packet never had.
+//!
+//! *What `L` is.* Before a collapse a full-spectrum path carries 36 bins, and
+//! between bins its throughput is their linear interpolation (the convention
+//! the weights `W_b` give a full-spectrum path); after it, every factor is its
+//! own value at λ. So the continuous and the full-spectrum estimates of the
+//! same light differ only in interpolating a product of spectra or
+//! multiplying interpolated spectra, which is second order in the 10 nm bin
+//! spacing (a fraction of a percent in saturated colours; the README's colour
+//! section measures it on the Cornell box).
+//!
+//! *Spectral output* (`--spectral`) keeps the bin centres and the discrete
+//! draws above ([`Contribution::CONTINUOUS`] is false for it), so that the 36
+//! channels weighted by `W_b` reproduce the colour film exactly.
 
 use crate::color::{self, N_BINS, Sampled, Spectrum, Xyz};
+
+mod continuous;
+
+// The single-wavelength draw for a collapse, for every integrator that follows one wavelength
+// (path's collapse uses it through the rotated form).
+#[allow(unused_imports)]
+pub use continuous::continuous_wavelength;
+pub use continuous::{for_each_rotated_continuous, sample_packet_continuous, tent_area};
 
 /// The wavelengths of the RGB mode (thesis §5.2): blue, green, red in nm.
 pub const RGB_LAMBDAS_NM: [f32; 3] = [435.8, 546.1, 700.0];
@@ -51,6 +114,11 @@ pub enum Readout {
     Spectral,
     /// Values are linear sRGB (blue, green, red), the RGB mode.
     Rgb,
+    /// Values are spectral radiance at continuous wavelengths (fractional
+    /// positions anywhere in 360-830 nm): each value's colour is
+    /// `L · cmf(λ) · weight` ([`color::cmf_at`]), the weight holding
+    /// `1 / (C · p(λ))` for the draw's density `p` per nm. See the module doc.
+    Continuous,
 }
 
 /// A packet of `N` wavelengths, as fractional bin positions, with the
@@ -123,6 +191,16 @@ impl<const N: usize> Lambdas<N> {
                 }
                 Xyz::new(x * self.weight, y * self.weight, z * self.weight)
             }
+            Readout::Continuous => {
+                let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
+                for i in 0..N {
+                    let c = color::cmf_at(self.lambda_nm(i));
+                    x += l.0[i] * c[0];
+                    y += l.0[i] * c[1];
+                    z += l.0[i] * c[2];
+                }
+                Xyz::new(x * self.weight, y * self.weight, z * self.weight)
+            }
             Readout::Rgb => {
                 // Values are (b, g, r) in wavelength order; a single wavelength
                 // after a split is one channel carrying the packet weight 3.
@@ -142,13 +220,31 @@ impl<const N: usize> Lambdas<N> {
     /// times the packet weight, in its bin (bins outside the packet are 0), so that
     /// `bins(l).to_xyz() == xyz(l)` up to rounding. The spectral film sums these. The RGB mode
     /// has no bins: it gives zero (the command line refuses `--spectral` with it).
+    ///
+    /// A continuous packet ([`Readout::Continuous`]) is never summed by the renderer (spectral
+    /// output keeps the bin centres, [`Contribution::CONTINUOUS`]); here it gives each bin `b`
+    /// the tent average `L(λ) · weight · φ_b(λ) / A_b`, an unbiased estimate of
+    /// `∫ φ_b · L / ∫ φ_b`, whose colour is the exact one only up to second order in 10 nm.
     pub fn bins(&self, l: &Sampled<N>) -> Spectrum {
         let mut out = Spectrum::ZERO;
-        if self.readout == Readout::Spectral {
-            for i in 0..N {
-                // Packets of sampled bins always sit on integer positions.
-                out.0[(self.pos[i] as usize).min(N_BINS - 1)] += l.0[i] * self.weight;
+        match self.readout {
+            Readout::Spectral => {
+                for i in 0..N {
+                    // Packets of sampled bins always sit on integer positions.
+                    out.0[(self.pos[i] as usize).min(N_BINS - 1)] += l.0[i] * self.weight;
+                }
             }
+            Readout::Continuous => {
+                for i in 0..N {
+                    let nm = self.lambda_nm(i);
+                    let b0 = (self.pos[i].max(0.0) as usize).min(N_BINS - 1);
+                    for b in b0..(b0 + 2).min(N_BINS) {
+                        let t = color::tent(b, nm as f64) as f32;
+                        out.0[b] += l.0[i] * self.weight * t / tent_area(b);
+                    }
+                }
+            }
+            Readout::Rgb => {}
         }
         out
     }
@@ -159,11 +255,18 @@ impl<const N: usize> Lambdas<N> {
 /// The integrators are generic over it, so the colour-only path pays nothing for spectral
 /// output.
 pub(crate) trait Contribution: Copy + Default + core::ops::AddAssign + Send + Sync + 'static {
+    /// Whether single-wavelength paths may carry continuous wavelengths
+    /// ([`Readout::Continuous`]): true for colour; false for spectral output, whose bins must
+    /// reproduce the colour exactly, so those paths stay at the bin centres.
+    const CONTINUOUS: bool;
+
     /// The contribution of a packet's radiance values.
     fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self;
 }
 
 impl Contribution for Xyz {
+    const CONTINUOUS: bool = true;
+
     #[inline]
     fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
         lambdas.xyz(l)
@@ -171,6 +274,8 @@ impl Contribution for Xyz {
 }
 
 impl Contribution for Spectrum {
+    const CONTINUOUS: bool = false;
+
     #[inline]
     fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
         lambdas.bins(l)
@@ -280,14 +385,37 @@ impl BinDistribution {
     /// probability. Bins of zero weight are never returned.
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
+        let bin = self.find(u * self.total);
+        (bin, self.prob(bin))
+    }
+
+    /// The bin [`Self::sample`] returns for `u`, and where `u` falls within
+    /// that bin's share, in [0, 1]: uniform again when `u` is, so one number
+    /// both picks a bin and places a wavelength in it.
+    #[inline]
+    pub fn sample_with_remainder(&self, u: f32) -> (usize, f32) {
         let x = u * self.total;
-        let bin = match self.cdf.iter().position(|&c| x < c) {
+        let bin = self.find(x);
+        let below = if bin == 0 { 0.0 } else { self.cdf[bin - 1] };
+        let share = self.cdf[bin] - below;
+        (bin, ((x - below) / share).clamp(0.0, 1.0))
+    }
+
+    /// The probability of bin `b` (0 for a bin of zero weight).
+    #[inline]
+    pub fn prob(&self, b: usize) -> f32 {
+        let below = if b == 0 { 0.0 } else { self.cdf[b - 1] };
+        (self.cdf[b] - below) / self.total
+    }
+
+    /// The bin whose share of the cumulative sum holds `x` in [0, total).
+    #[inline]
+    fn find(&self, x: f32) -> usize {
+        match self.cdf.iter().position(|&c| x < c) {
             Some(b) => b,
             // `u · total` rounded up to `total`: the last bin of positive weight.
             None => self.cdf.iter().rposition(|&c| c < self.total).map_or(0, |b| b + 1),
-        };
-        let below = if bin == 0 { 0.0 } else { self.cdf[bin - 1] };
-        (bin, (self.cdf[bin] - below) / self.total)
+        }
     }
 }
 

@@ -24,9 +24,19 @@ pub fn shared(rel: &str) -> Option<PathBuf> {
 
 /// Renders a scene given as RON text with overrides; returns the film.
 pub fn render_str(ron: &str, overrides: &SettingsPatch) -> Film {
+    render_film(ron, overrides, false)
+}
+
+/// As [`render_str`] on a spectral film (`--spectral`): the film also sums the 36 bins, and
+/// single-wavelength paths stay at the bin centres.
+pub fn render_str_bins(ron: &str, overrides: &SettingsPatch) -> Film {
+    render_film(ron, overrides, true)
+}
+
+fn render_film(ron: &str, overrides: &SettingsPatch, bins: bool) -> Film {
     let scene = load_scene_str(ron, Path::new("test.ron"), overrides).expect("test scene loads");
     let s = &scene.settings;
-    let mut film = Film::new(s.width, s.height);
+    let mut film = if bins { Film::new_spectral(s.width, s.height, 0) } else { Film::new(s.width, s.height) };
     let stop = AtomicBool::new(false);
     let stats = render(&scene, &mut film, 0..s.spp, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
     assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");

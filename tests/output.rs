@@ -150,6 +150,14 @@ fn spectral_exr_bins_reproduce_the_xyz() {
     // --spectral needs an EXR.
     let o = rust_v(&["render", "scenes/prism.ron", "-o", dir.join("x.png").to_str().unwrap(), "--spectral", "--quiet"]);
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--spectral needs an .exr"));
+    // --spectral keeps the bin centres, so it refuses continuous packets (as it refuses rgb).
+    let out = dir.join("x.exr");
+    let args = ["render", "scenes/prism.ron", "-o", out.to_str().unwrap(), "--spectral", "--quiet"];
+    for w in ["continuous", "rgb"] {
+        let o = rust_v(&[&args[..], &["--integrator", "spectral", "--wavelengths", w]].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains("--spectral") && err.contains(w), "{w}: {err}");
+    }
 }
 
 /// Through the binary: two halves rendered with `--passes` and `--spectral`, merged, give the

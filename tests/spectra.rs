@@ -120,3 +120,28 @@ fn bad_spectra_are_errors_naming_where() {
     let e = reflectance("Rgb(-0.1, 0, 0)", &dir).unwrap_err();
     assert!(e.contains("linear sRGB"), "{e}");
 }
+
+/// Paths after a dispersive split carry any wavelength in 360-830 nm, so an index of refraction
+/// must be finite and positive on all of it: a Sellmeier term whose pole (√C µm) lies at 780 nm,
+/// beyond the last bin but inside the range, is refused with the field and the pole named; a
+/// Cauchy index that reaches 0 at 770 nm (positive at every bin) is refused with the first
+/// wavelength where it is not positive; N-SF11 loads.
+#[test]
+fn an_index_with_a_pole_or_a_zero_in_the_visible_range_is_refused() {
+    let scene = |ior: &str| {
+        format!(
+            r#"(
+            camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 30),
+            materials: {{ "g": Dielectric(ior: {ior}) }},
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "g") ],
+        )"#
+        )
+    };
+    let err =
+        |ior: &str| load_scene_str(&scene(ior), Path::new("ior.ron"), &Default::default()).err().map(|e| e.to_string());
+    let pole = err("Sellmeier(b: (1.0, 0.2, 0.9), c: (0.6084, 0.06, 100.0))").expect("a pole at 780 nm is refused");
+    assert!(pole.contains("ior.ron") && pole.contains("780.0 nm") && pole.contains("materials"), "{pole}");
+    let zero = err("Cauchy(a: -1.0, b: 0.5929)").expect("a negative index is refused");
+    assert!(zero.contains("770 nm") && zero.contains("positive"), "{zero}");
+    assert_eq!(err("Named(\"N-SF11\")"), None);
+}

@@ -46,6 +46,14 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     {
         return Err(Error::Settings("--spectral: the RGB mode (--wavelengths rgb) has no spectral bins".into()));
     }
+    if args.spectral
+        && s.integrator == rust_v::settings::IntegratorKind::Spectral
+        && s.wavelengths == rust_v::settings::WavelengthsKind::Continuous
+    {
+        return Err(Error::Settings(
+            "--spectral keeps the 36 bin centres, so it cannot follow --wavelengths continuous (use hero)".into(),
+        ));
+    }
     if !args.run.quiet {
         say(format_args!(
             "{} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}",

@@ -97,6 +97,29 @@ pub fn color_weights() -> &'static [[f32; 3]; N_BINS] {
     &W
 }
 
+/// The colour matching functions at any wavelength, for paths that carry a continuous
+/// wavelength (after a dispersive split or collapse): the 1 nm table linearly interpolated
+/// (the same function the weights integrate) and divided by `∫ ȳ dλ` over 360-830 nm, the
+/// weights' normalisation, so that `∫ cmf_at(λ) · L(λ) dλ` is the XYZ of `L` and, for a spectrum
+/// given by 36 bins, equals `Σ_b W_b · L_b`. Per nm; zero outside 360-830 nm (and for NaN).
+pub fn cmf_at(lambda_nm: f32) -> [f32; 3] {
+    static TABLE: LazyLock<Vec<[f32; 3]>> = LazyLock::new(|| {
+        let t = cmf_1nm();
+        // ∫ ȳ of the linearly interpolated table: the trapezoidal rule is exact.
+        let y: f64 = t.windows(2).map(|p| 0.5 * (p[0].1[1] + p[1].1[1]) * (p[1].0 - p[0].0)).sum();
+        t.iter().map(|r| r.1.map(|v| (v / y) as f32)).collect()
+    });
+    let x = lambda_nm - INTEGRAL_RANGE_NM.0 as f32;
+    let last = TABLE.len().saturating_sub(1);
+    if !(x >= 0.0 && x <= last as f32) {
+        return [0.0; 3];
+    }
+    let i = (x as usize).min(last.saturating_sub(1));
+    let f = x - i as f32;
+    let (a, b) = (TABLE[i], TABLE[(i + 1).min(last)]);
+    std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f)
+}
+
 /// CIE 1931 2-degree x̄ ȳ z̄ at the 36 bin centres (raw table values, not the colour weights).
 ///
 /// Source: CIE 1931 2-degree CMFs, 380-730 nm at 10 nm, from colour-science 0.4.7 as tabulated

@@ -15,7 +15,7 @@ mod space;
 mod spectrum;
 mod uplift;
 
-pub use cie::{CMF, INTEGRAL_RANGE_NM, bin_xyz, color_weights, color_weights_f64, tent, tent_weights};
+pub use cie::{CMF, INTEGRAL_RANGE_NM, bin_xyz, cmf_at, color_weights, color_weights_f64, tent, tent_weights};
 pub use named::{COLOR_CHECKER_NAMES, blackbody, color_checker, d65, equal_energy, planck, reflectance_to_xyz};
 pub use rgb::{
     LINEAR_SRGB_TO_XYZ, LinearSrgb, Srgb, XYZ_TO_LINEAR_SRGB, Xyz, srgb_eotf, srgb_oetf, xyz_to_linear_srgb_f64,

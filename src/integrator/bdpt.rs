@@ -43,19 +43,25 @@
 //! # Wavelengths
 //! Both subpaths carry the full 36-bin spectrum. Sampling a direction at a
 //! dispersive surface needs one wavelength, so there the sample **collapses**
-//! to one bin `b`, drawn once per camera sample from the fixed distribution
-//! `p(b) ∝` visual importance ([`bin_importance`]) by `u_λ`: whichever
-//! subpath meets dispersion first, both use the same `b`, so their
-//! wavelengths agree at every connection. The dispersive BSDF is sampled at
-//! `b` and its value is zero in every other bin, so the subpath's throughput
-//! from there on is masked to `b`. A connection whose prefixes include a
-//! collapse (or whose end vertex is rough dispersive glass, evaluated at `b`)
-//! contributes `c(b)/p(b)` in bin `b` only.
+//! to one wavelength λ, drawn once per camera sample by `u_λ`: a bin `b` from
+//! the fixed distribution `P_b ∝` visual importance ([`bin_importance`]), then
+//! λ within `b`'s interpolation tent ([`continuous_wavelength`], density
+//! `p(λ) = Σ_b P_b φ_b(λ)/A_b`; with `--spectral` output λ stays at the bin
+//! centre, `p = P_b`, so the bins reproduce the colour exactly). Whichever
+//! subpath meets dispersion first, both use the same λ, so their wavelengths
+//! agree at every connection. From the collapse on, a subpath's throughput is
+//! one value at λ (kept in one slot of its spectrum), and every material,
+//! spectrum and index of refraction it meets is evaluated at λ. A connection
+//! whose prefixes include a collapse (or whose end vertex is rough dispersive
+//! glass) is computed at λ alone: each full-spectrum factor is interpolated
+//! there, and the value `c(λ)` adds `c(λ) cmf(λ) / p(λ)` to the pixel (read
+//! out through the one-wavelength packet).
 //!
-//! *Unbiased:* `b` is independent of everything before the collapse and
-//! `p(b) > 0` for every bin, so `E_b[c(b) e_b / p(b)] = Σ_b c(b) e_b`, the full
-//! spectrum, for every strategy on its own; connections whose prefixes never
-//! met dispersion are full-spectrum and need no such weight. The MIS weights
+//! *Unbiased:* λ is independent of everything before the collapse and
+//! `p(λ) > 0` wherever the colour matching functions are, so
+//! `E_λ[c(λ) cmf(λ) / p(λ)] = ∫ c cmf dλ`, the colour integral, for every
+//! strategy on its own; connections whose prefixes never met dispersion are
+//! full-spectrum (read out with the bin weights `W_b`) and need no such weight. The MIS weights
 //! use the same densities in every strategy (the reference-wavelength BSDF
 //! pdf at rough dispersive vertices), so they sum to 1 over the strategies of
 //! each path and any such weights keep the sum unbiased. A throughput-driven
@@ -74,13 +80,13 @@ use std::sync::LazyLock;
 use glam::{Vec2, Vec3};
 
 use crate::bxdf::Bxdf;
-use crate::color::{Sampled, Spectrum};
+use crate::color::{N_BINS, Sampled, Spectrum};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
 use crate::light::Light;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
-use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance};
+use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, continuous_wavelength};
 
 use super::path::RR_DEPTH;
 use super::{Estimator, Shading};
@@ -152,6 +158,8 @@ impl Vertex {
 /// The one wavelength a sample collapses to, drawn lazily from `u_λ`.
 struct Wavelength {
     u: f32,
+    /// Continuous wavelengths (colour output); bin centres for spectral output.
+    continuous: bool,
     drawn: Option<Single>,
 }
 
@@ -171,10 +179,15 @@ impl Wavelength {
             let importance = bin_importance();
             BinDistribution::new(|b| importance[b]).expect("visual importance is positive")
         });
-        let u = self.u;
+        let (u, continuous) = (self.u, self.continuous);
         *self.drawn.get_or_insert_with(|| {
-            let (b, p) = DIST.sample(u);
-            Single { slot: b, lambdas: Lambdas { pos: [b as f32], weight: 1.0 / p, readout: Readout::Spectral } }
+            if continuous {
+                let (lambdas, _) = continuous_wavelength(&DIST, u);
+                Single { slot: (lambdas.pos[0].round().max(0.0) as usize).min(N_BINS - 1), lambdas }
+            } else {
+                let (b, p) = DIST.sample(u);
+                Single { slot: b, lambdas: Lambdas { pos: [b as f32], weight: 1.0 / p, readout: Readout::Spectral } }
+            }
         })
     }
 
@@ -222,7 +235,7 @@ impl Estimator for Bdpt {
             let (camera, light) = &mut *paths;
             camera.clear();
             light.clear();
-            let mut wl = Wavelength { u: sampler.next_1d(), drawn: None };
+            let mut wl = Wavelength { u: sampler.next_1d(), continuous: O::CONTINUOUS, drawn: None };
             let full = Lambdas::full();
             let (mut l, mut l_single) = (Spectrum::ZERO, 0.0f32);
             if !self.light_only {

@@ -6,8 +6,8 @@
 //! |---|---|---|
 //! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
 //! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
-//! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface; or `--wavelengths rgb` |
-//! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own: no wavelength noise where nothing disperses |
+//! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface: bins, or continuous wavelengths where glass disperses (`--wavelengths continuous`: everywhere); or `--wavelengths rgb` |
+//! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own at a continuous wavelength within its bin: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
 //! (the crate-internal `spectral` module), and picked once per render (`Estimator`) so the
@@ -46,7 +46,7 @@ use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
 use crate::settings::{IntegratorKind, WavelengthsKind};
-use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet};
+use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet, sample_packet_continuous};
 
 /// Computes the colour of one camera sample. Implementations are chosen once
 /// per render and the render loop is generic over them.
@@ -100,15 +100,22 @@ impl Estimator for FullSpectrum {
     }
 }
 
-/// A packet of `C` sampled wavelengths per camera sample (the `spectral` integrator).
-pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling);
+/// A packet of `C` sampled wavelengths per camera sample (the `spectral` integrator): bins, or
+/// continuous wavelengths for colour output in a scene with dispersive glass (or in any scene
+/// when the third field is set, `--wavelengths continuous`); see `crate::spectral`.
+pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling, pub bool);
 
 impl<const C: usize> Estimator for Packets<C> {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
         let ray = scene.camera.ray(film);
         let u: [f32; C] = std::array::from_fn(|_| sampler.next_1d());
-        self.0.li(scene, ray, &sample_packet::<C>(self.1, u), sampler)
+        let lambdas = if O::CONTINUOUS && (self.2 || scene.has_dispersion()) {
+            sample_packet_continuous::<C>(self.1, u)
+        } else {
+            sample_packet::<C>(self.1, u)
+        };
+        self.0.li(scene, ray, &lambdas, sampler)
     }
 }
 
@@ -140,16 +147,17 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
         IntegratorKind::Whitted => f.call(&FullSpectrum(whitted)),
         IntegratorKind::Path => f.call(&FullSpectrum(path(false))),
         IntegratorKind::Spectral => {
-            let how = match settings.wavelengths {
+            let (how, always) = match settings.wavelengths {
                 WavelengthsKind::Rgb => return f.call(&RgbWavelengths(path(true))),
-                WavelengthsKind::Hero => WavelengthSampling::Hero,
-                WavelengthsKind::Random => WavelengthSampling::Random,
+                WavelengthsKind::Hero => (WavelengthSampling::Hero, false),
+                WavelengthsKind::Random => (WavelengthSampling::Random, false),
+                WavelengthsKind::Continuous => (WavelengthSampling::Hero, true),
             };
             match settings.packet_size {
-                1 => f.call(&Packets::<1>(path(true), how)),
-                2 => f.call(&Packets::<2>(path(true), how)),
-                8 => f.call(&Packets::<8>(path(true), how)),
-                _ => f.call(&Packets::<4>(path(true), how)),
+                1 => f.call(&Packets::<1>(path(true), how, always)),
+                2 => f.call(&Packets::<2>(path(true), how, always)),
+                8 => f.call(&Packets::<8>(path(true), how, always)),
+                _ => f.call(&Packets::<4>(path(true), how, always)),
             }
         }
     }
@@ -180,7 +188,7 @@ pub fn describe(scene: &Scene) -> String {
             if dispersive { "; the full spectrum until a subpath refracts at dispersive glass, then one wavelength" } else { ", full spectrum" }
         ),
         IntegratorKind::Auto if dispersive => format!(
-            "auto: dispersive material present: full-spectrum path tracing; a path that refracts at dispersive glass continues as {} single wavelengths drawn by throughput and visual importance",
+            "auto: dispersive material present: full-spectrum path tracing; a path that refracts at dispersive glass continues as {} single continuous wavelengths (bin centres with --spectral) drawn by throughput and visual importance",
             s.packet_size
         ),
         IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),
@@ -195,6 +203,15 @@ pub fn describe(scene: &Scene) -> String {
         IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
         IntegratorKind::Spectral => match s.wavelengths {
             WavelengthsKind::Rgb => "spectral, rgb: three wavelengths (435.8, 546.1, 700 nm) read out as RGB".into(),
+            WavelengthsKind::Continuous => format!(
+                "spectral, continuous: hero packets of {} wavelengths anywhere in 360-830 nm, every spectrum interpolated at each",
+                s.packet_size
+            ),
+            w if dispersive => format!(
+                "spectral, {w:?} packets of {} continuous wavelengths (dispersive glass; bin centres with --spectral), split at dispersive surfaces",
+                s.packet_size
+            )
+            .to_lowercase(),
             w => format!("spectral, {w:?} packets of {} wavelengths, split at dispersive surfaces", s.packet_size).to_lowercase(),
         },
     }

@@ -22,24 +22,35 @@
 //!    (`PathTracer::collapse`). At a *rough* dispersive dielectric every
 //!    lobe's direction depends on the wavelength, so `auto` collapses the
 //!    whole path there, to `C` bins drawn the same way, each walking on from
-//!    this hit (light sample and BSDF sample at its own index);
+//!    this hit (light sample and BSDF sample at its own index). For colour
+//!    output these single wavelengths are continuous (`crate::spectral`,
+//!    "Continuous wavelengths"): each drawn within its bin's tent, at the
+//!    interpolated throughput, refracting at its exact index; spectral output
+//!    keeps the bin centres;
 //! 4. at a non-delta surface add direct light (one light sample, MIS);
 //! 5. sample the BSDF for the next direction and update `β ← β f |cos| / pdf`;
 //! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
 //!    and divide `β` by `q` (unbiased).
 
 use crate::bxdf::{BsdfSample, Dispersion, MediumStack};
-use crate::color::{N_BINS, Sampled};
+use crate::color::{N_BINS, Sampled, Spectrum};
 use crate::geometry::Ray;
 use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
 use crate::scene::{Scene, SurfaceHit};
-use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated};
+use crate::spectral::{
+    BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated, for_each_rotated_continuous,
+};
 
 use super::{Interface, MAX_PASSES, Shading, absorption, interface, sample_direct};
 
 /// Bounces after which Russian roulette starts (Mitsuba's `rr_depth`).
 pub const RR_DEPTH: u32 = 5;
+
+/// The largest probability of reflection at a collapse with continuous
+/// wavelengths: every bin may be totally reflected while wavelengths beyond
+/// 730 nm (lower index) still refract, so refraction keeps at least 2⁻¹⁰.
+const MAX_CONTINUOUS_P_REFLECT: f32 = 1.0 - 1.0 / 1024.0;
 
 /// The unidirectional path tracer.
 #[derive(Clone, Copy, Debug)]
@@ -181,6 +192,15 @@ impl PathTracer {
                         break;
                     };
                     let u = sampler.next_1d();
+                    if O::CONTINUOUS {
+                        // Continuous wavelengths, each at the interpolated throughput.
+                        for_each_rotated_continuous(&dist, self.collapse_to as usize, u, |l1, weight| {
+                            let one = Walk { beta: Sampled([beta_at(&w.beta, &l1)]), ..copy_walk(&w) };
+                            let l1 = Lambdas { weight: lambdas.weight * weight, ..l1 };
+                            split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::Split);
+                        });
+                        break;
+                    }
                     for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
                         let one = Walk { beta: Sampled([w.beta[bin]]), ..copy_walk(&w) };
                         let l1 =
@@ -253,7 +273,13 @@ impl PathTracer {
     /// throughput × [`bin_importance`], each weighted `1 / (C · p(bin))`,
     /// each refracting at its own index as a single-wavelength walk of
     /// throughput `β(λ) (1 − F(λ)) / (1 − P_r)` whose colour is added to
-    /// `split`. Returns `None` after a collapse (or a dead path).
+    /// `split`. For colour output each wavelength is then placed
+    /// continuously within its bin's tent ([`for_each_rotated_continuous`],
+    /// weight `1 / (C · p(λ))`), `β(λ)` interpolated between bins and `F`
+    /// and the index taken at λ exactly; `P_r` is then at most
+    /// `1 − 2⁻¹⁰`, since wavelengths beyond the last bin may refract where
+    /// every bin is totally reflected. Returns `None` after a collapse (or a
+    /// dead path).
     ///
     /// Any `P_r` that is below 1 wherever some wavelength is transmitted keeps
     /// this unbiased. Arriving from outside (always, unless the camera or an
@@ -296,6 +322,9 @@ impl PathTracer {
             }
             ((reflected / total).clamp(0.0, 1.0), Some(fr))
         };
+        // Continuous wavelengths beyond 730 nm may refract where every bin is
+        // totally reflected: refraction must stay possible.
+        let p_reflect = if O::CONTINUOUS { p_reflect.min(MAX_CONTINUOUS_P_REFLECT) } else { p_reflect };
         if sampler.next_1d() < p_reflect {
             let fr = all_fr.unwrap_or_else(|| glass.reflectance(sh.wo, lambdas));
             return Some(fr / p_reflect);
@@ -303,6 +332,17 @@ impl PathTracer {
         let p_refract = 1.0 - p_reflect;
         let dist = BinDistribution::new(|b| w.beta[b] * importance[b])?;
         let u = sampler.next_1d();
+        if O::CONTINUOUS {
+            // Each wavelength at its own λ: the interpolated throughput, the
+            // reflectance and index at λ exactly.
+            for_each_rotated_continuous(&dist, self.collapse_to as usize, u, |l1, weight| {
+                let fr = glass.reflectance_at(cos, l1.pos[0]);
+                let one = Walk { beta: Sampled([beta_at(&w.beta, &l1) * (1.0 - fr) / p_refract]), ..copy_walk(w) };
+                let l1 = Lambdas { weight: lambdas.weight * weight, ..l1 };
+                *split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
+            });
+            return None;
+        }
         for_each_rotated(&dist, self.collapse_to as usize, u, |bin, weight| {
             let fr = match all_fr {
                 Some(fr) => fr[bin],
@@ -342,6 +382,13 @@ fn refraction<const N: usize>(d: Dispersion<'_>, wo: glam::Vec3, lambdas: &Lambd
     let one = Lambdas { pos: [lambdas.pos[0]], weight: lambdas.weight, readout: lambdas.readout };
     let s = d.sample_refraction(wo, &one)?;
     Some(BsdfSample { wi: s.wi, f: Sampled::splat(s.f[0]), pdf: s.pdf, is_delta: s.is_delta, eta: s.eta })
+}
+
+/// A full-spectrum throughput (`N` = 36) at the continuous wavelength of
+/// `one`: linear between bins, flat beyond the end bins.
+#[inline]
+fn beta_at<const N: usize>(beta: &Sampled<N>, one: &Lambdas<1>) -> f32 {
+    one.sample(&Spectrum::from_fn(|b| beta.0.get(b).copied().unwrap_or(0.0)))[0]
 }
 
 /// The packet-independent part of a walk's state, for a split.

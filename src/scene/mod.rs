@@ -75,6 +75,9 @@ pub struct Scene {
     /// Indices of unbounded objects (planes).
     unbounded: Vec<u32>,
     bvh: Option<Bvh>,
+    /// Whether any object's material is dispersive (computed once: the
+    /// `spectral` integrator asks for every camera sample).
+    dispersive: bool,
     /// The identity of the scene file and every file it reads (for
     /// checkpoints: resume and merge refuse other inputs).
     pub content_hash: u64,
@@ -133,7 +136,9 @@ impl Scene {
                 acc
             })
             .collect();
+        let dispersive = objects.iter().any(|o| materials.get(o.material as usize).is_some_and(Bxdf::is_dispersive));
         Scene {
+            dispersive,
             objects,
             materials,
             lights,
@@ -237,8 +242,9 @@ impl Scene {
     }
 
     /// True when any material's direction depends on wavelength.
+    #[inline]
     pub fn has_dispersion(&self) -> bool {
-        self.objects.iter().any(|o| self.materials[o.material as usize].is_dispersive())
+        self.dispersive
     }
 
     /// The number of objects.

@@ -152,7 +152,25 @@ impl Ctx<'_> {
                 self.err(field, format!("unknown glass \"{name}\"; expected one of: {}", names.join(", ")))
             })?,
         };
-        for lambda in [color::LAMBDA_MIN_NM, 550.0, color::bin_lambda_nm(N_BINS - 1)] {
+        // Paths after a dispersive split carry any wavelength of the colour integral's range
+        // (360-830 nm), so the index must be finite and positive on all of it: no Sellmeier pole
+        // inside, and positive at every nm (and between, by continuity).
+        let (lo, hi) = color::INTEGRAL_RANGE_NM;
+        if let Ior::Sellmeier { b, c } = &ior
+            && let Some(i) =
+                (0..4).find(|&i| b[i] != 0.0 && c[i] > 0.0 && (lo..=hi).contains(&(c[i].sqrt() as f64 * 1e3)))
+        {
+            return Err(self.err(
+                field,
+                format!(
+                    "a Sellmeier term (C = {}) has its pole at {:.1} nm, inside 360-830 nm; expected poles outside the visible range",
+                    c[i],
+                    c[i].sqrt() * 1e3
+                ),
+            ));
+        }
+        for step in 0..=(hi - lo) as usize {
+            let lambda = (lo + step as f64) as f32;
             let n = ior.at(lambda);
             if !(n.is_finite() && n > 0.0) {
                 return Err(self
