@@ -13,7 +13,7 @@
 
 use super::Node;
 use crate::geometry::Aabb;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
 /// Number of SAH bins per axis.
@@ -37,12 +37,45 @@ pub(super) struct Limits {
     pub max_depth: u32,
 }
 
-/// A primitive during the build: its box, its centroid and its index in the input slice.
+/// A box in SIMD registers (glam's `Vec3A`: one SSE register per corner), so that a union
+/// is two instructions. Minima and maxima are exact, so the boxes equal [`Aabb`]'s.
+#[derive(Clone, Copy, Debug)]
+struct Box3A {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3A {
+    const EMPTY: Box3A = Box3A { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn union(self, o: Box3A) -> Box3A {
+        Box3A { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    #[inline(always)]
+    fn grow(self, p: Vec3A) -> Box3A {
+        Box3A { min: self.min.min(p), max: self.max.max(p) }
+    }
+
+    fn aabb(self) -> Aabb {
+        Aabb { min: self.min.into(), max: self.max.into() }
+    }
+}
+
+/// A primitive during the build: its box and its index in the input slice.
 #[derive(Clone, Copy, Debug)]
 struct BuildPrim {
-    bounds: Aabb,
-    centroid: Vec3,
+    bounds: Box3A,
     index: u32,
+}
+
+impl BuildPrim {
+    /// `(min + max) * 0.5`, as [`Aabb::centroid`].
+    #[inline(always)]
+    fn centroid(&self) -> Vec3A {
+        (self.bounds.min + self.bounds.max) * 0.5
+    }
 }
 
 /// Builds the tree over `prim_bounds`: the nodes (depth first, root first) and the slot
@@ -51,7 +84,7 @@ pub(super) fn build_tree(prim_bounds: &[Aabb], limits: Limits) -> (Vec<Node>, Ve
     let mut prims: Vec<BuildPrim> = prim_bounds
         .iter()
         .enumerate()
-        .map(|(i, b)| BuildPrim { bounds: *b, centroid: b.centroid(), index: i as u32 })
+        .map(|(i, b)| BuildPrim { bounds: Box3A { min: b.min.into(), max: b.max.into() }, index: i as u32 })
         .collect();
     let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
     if !prims.is_empty() {
@@ -68,7 +101,7 @@ fn ceil_log2(n: usize) -> u32 {
 
 #[derive(Clone, Copy)]
 struct Bin {
-    bounds: Aabb,
+    bounds: Box3A,
     count: u32,
 }
 
@@ -76,7 +109,7 @@ struct Bin {
 /// centroids fall in each of [`BINS`] equal slices of the centroid bounds.
 type Bins = [[Bin; BINS]; 3];
 
-const EMPTY_BINS: Bins = [[Bin { bounds: Aabb::EMPTY, count: 0 }; BINS]; 3];
+const EMPTY_BINS: Bins = [[Bin { bounds: Box3A::EMPTY, count: 0 }; BINS]; 3];
 
 /// Bin of centroid coordinate `c` (same formula for binning and partitioning).
 #[inline(always)]
@@ -87,10 +120,11 @@ fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
 /// Adds `prims` to `bins`.
 fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3, scale: [f32; 3]) {
     for p in prims {
+        let c = p.centroid();
         for a in 0..3 {
-            let b = &mut bins[a][bin_of(p.centroid[a], lo[a], scale[a])];
+            let b = &mut bins[a][bin_of(c[a], lo[a], scale[a])];
             b.count += 1;
-            b.bounds = b.bounds.union(&p.bounds);
+            b.bounds = b.bounds.union(p.bounds);
         }
     }
 }
@@ -98,14 +132,15 @@ fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3, scale: [f32; 3]) {
 /// Bounds and centroid bounds of `prims` (in parallel over fixed chunks when large).
 fn node_bounds(prims: &[BuildPrim], threshold: usize) -> (Aabb, Aabb) {
     let one = |ps: &[BuildPrim]| {
-        ps.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), p| (b.union(&p.bounds), c.grow(p.centroid)))
+        ps.iter().fold((Box3A::EMPTY, Box3A::EMPTY), |(b, c), p| (b.union(p.bounds), c.grow(p.centroid())))
     };
-    if prims.len() > threshold {
-        let parts: Vec<(Aabb, Aabb)> = prims.par_chunks(BIN_CHUNK).map(one).collect();
-        parts.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), (pb, pc)| (b.union(pb), c.union(pc)))
+    let (b, c) = if prims.len() > threshold {
+        let parts: Vec<(Box3A, Box3A)> = prims.par_chunks(BIN_CHUNK).map(one).collect();
+        parts.iter().fold((Box3A::EMPTY, Box3A::EMPTY), |(b, c), (pb, pc)| (b.union(*pb), c.union(*pc)))
     } else {
         one(prims)
-    }
+    };
+    (b.aabb(), c.aabb())
 }
 
 /// Builds the subtree over `prims` (slots `first..first + prims.len()`), appending its
@@ -146,7 +181,7 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
                 for a in 0..3 {
                     for i in 0..BINS {
                         bins[a][i].count += part[a][i].count;
-                        bins[a][i].bounds = bins[a][i].bounds.union(&part[a][i].bounds);
+                        bins[a][i].bounds = bins[a][i].bounds.union(part[a][i].bounds);
                     }
                 }
             }
@@ -163,22 +198,22 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
             }
             // Right-to-left sweep: area * count of the right part for each split.
             let mut right = [0.0f32; BINS];
-            let mut rb = Aabb::EMPTY;
+            let mut rb = Box3A::EMPTY;
             let mut rc = 0u32;
             for i in (1..BINS).rev() {
-                rb = rb.union(&bins[a][i].bounds);
+                rb = rb.union(bins[a][i].bounds);
                 rc += bins[a][i].count;
-                right[i - 1] = rb.surface_area() * rc as f32;
+                right[i - 1] = rb.aabb().surface_area() * rc as f32;
             }
-            let mut lb = Aabb::EMPTY;
+            let mut lb = Box3A::EMPTY;
             let mut lc = 0u32;
             for i in 0..BINS - 1 {
-                lb = lb.union(&bins[a][i].bounds);
+                lb = lb.union(bins[a][i].bounds);
                 lc += bins[a][i].count;
                 if lc == 0 || lc as usize == n {
                     continue;
                 }
-                let cost = lb.surface_area() * lc as f32 + right[i];
+                let cost = lb.aabb().surface_area() * lc as f32 + right[i];
                 if cost < best_cost {
                     best_cost = cost;
                     split = Some((a, i));
@@ -200,7 +235,7 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
     let (mid, axis) = match split {
         Some((a, last)) => {
             let (lo, scale) = (cb.min[a], BINS as f32 / extent[a]);
-            (partition(prims, |p| bin_of(p.centroid[a], lo, scale) <= last), a)
+            (partition(prims, |p| bin_of(p.centroid()[a], lo, scale) <= last), a)
         }
         None => {
             // Median split on the widest centroid axis, ties broken by index.
@@ -213,7 +248,7 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
             };
             let mid = n / 2;
             prims.select_nth_unstable_by(mid, |p, q| {
-                p.centroid[a].total_cmp(&q.centroid[a]).then(p.index.cmp(&q.index))
+                p.centroid()[a].total_cmp(&q.centroid()[a]).then(p.index.cmp(&q.index))
             });
             (mid, a)
         }
