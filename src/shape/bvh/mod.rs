@@ -6,8 +6,11 @@
 //!
 //! The BVH knows nothing of the primitives themselves: traversal calls back with
 //! the slot `k` of each primitive in a visited leaf. [`Bvh::prim_order`] maps slots
-//! to indices in the slice the tree was built from; meshes store their triangles
-//! in slot order so that leaves are contiguous in memory.
+//! to indices in the slice the tree was built from. Scenes use it over their shapes.
+//!
+//! Meshes use [`WideBvh`] instead (`wide.rs`): the same build (`build.rs`), collapsed
+//! into 4-wide nodes whose leaves hold the triangles themselves, four to a block
+//! (`tri4.rs`), in this tree's slot order.
 
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
