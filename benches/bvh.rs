@@ -113,7 +113,11 @@ fn main() {
     println!("| BVH build, 2 threads (median/5)  | {:>9.3} s  |", build2.as_secs_f64());
     println!("| of which binary SAH, 1 / 2 thr.  | {:.3} / {:.3} s |", binary1.as_secs_f64(), binary2.as_secs_f64());
     println!("| 4-wide nodes (128 B)             | {:>12} |", mb.node_count());
-    println!("| 4-triangle blocks (144 B)        | {:>12} | ({:.0}% of lanes used)", mb.block_count(), 25.0 * n as f64 / mb.block_count() as f64);
+    println!(
+        "| 4-triangle blocks (144 B)        | {:>12} | ({:.0}% of lanes used)",
+        mb.block_count(),
+        25.0 * n as f64 / mb.block_count() as f64
+    );
     println!("| nodes + index bytes / triangle   | {:>12.1} |", mb.memory_bytes() as f64 / n as f64);
     println!("| vertex bytes / triangle (blocks) | {:>12.1} |", mb.triangle_bytes() as f64 / n as f64);
     println!("| SAH cost (node 1, block 1)       | {:>12.2} |", mb.sah_cost());

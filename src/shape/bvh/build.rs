@@ -78,13 +78,15 @@ impl BuildPrim {
     }
 }
 
-/// Builds the tree over `prim_bounds`: the nodes (depth first, root first) and the slot
-/// order (slot `k` of a leaf holds primitive `order[k]` of the input).
-pub(super) fn build_tree(prim_bounds: &[Aabb], limits: Limits) -> (Vec<Node>, Vec<u32>) {
-    let mut prims: Vec<BuildPrim> = prim_bounds
-        .iter()
-        .enumerate()
-        .map(|(i, b)| BuildPrim { bounds: Box3A { min: b.min.into(), max: b.max.into() }, index: i as u32 })
+/// Builds the tree over `n` primitives whose boxes `prim_bounds(i)` gives: the nodes
+/// (depth first, root first) and the slot order (slot `k` of a leaf holds primitive
+/// `order[k]` of the input).
+pub(super) fn build_tree(n: usize, prim_bounds: impl Fn(usize) -> Aabb, limits: Limits) -> (Vec<Node>, Vec<u32>) {
+    let mut prims: Vec<BuildPrim> = (0..n)
+        .map(|i| {
+            let b = prim_bounds(i);
+            BuildPrim { bounds: Box3A { min: b.min.into(), max: b.max.into() }, index: i as u32 }
+        })
         .collect();
     let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
     if !prims.is_empty() {

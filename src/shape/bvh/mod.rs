@@ -137,7 +137,8 @@ impl Bvh {
     }
 
     fn build_with_threshold(prim_bounds: &[Aabb], threshold: usize) -> Bvh {
-        let (nodes, order) = build_tree(prim_bounds, Limits { threshold, max_depth: STACK as u32 });
+        let (nodes, order) =
+            build_tree(prim_bounds.len(), |i| prim_bounds[i], Limits { threshold, max_depth: STACK as u32 });
         Bvh { nodes, order }
     }
 

@@ -61,7 +61,10 @@ impl Node4 {
 
     fn child_box(&self, lane: usize) -> Aabb {
         let b = &self.b;
-        Aabb { min: Vec3::new(b[0][0][lane], b[0][1][lane], b[0][2][lane]), max: Vec3::new(b[1][0][lane], b[1][1][lane], b[1][2][lane]) }
+        Aabb {
+            min: Vec3::new(b[0][0][lane], b[0][1][lane], b[0][2][lane]),
+            max: Vec3::new(b[1][0][lane], b[1][1][lane], b[1][2][lane]),
+        }
     }
 }
 
@@ -140,9 +143,8 @@ impl WideBvh {
     }
 
     fn build_with_threshold(tris: &[[Vec3; 3]], threshold: usize) -> WideBvh {
-        let bounds: Vec<Aabb> = tris.iter().map(|[a, b, c]| Aabb::new(*a, *b).grow(*c)).collect();
-        let (bin, order) = build_tree(&bounds, Limits { threshold, max_depth: BINARY_DEPTH });
-        drop(bounds);
+        let limits = Limits { threshold, max_depth: BINARY_DEPTH };
+        let (bin, order) = build_tree(tris.len(), |i| Aabb::new(tris[i][0], tris[i][1]).grow(tris[i][2]), limits);
         // Slot range (first, count) of every binary subtree; children follow their parent.
         let mut range = vec![(0u32, 0u32); bin.len()];
         for i in (0..bin.len()).rev() {
@@ -458,7 +460,11 @@ mod tests {
                     assert_eq!(h.v, [tri.v0, tri.v1, tri.v2]);
                     assert_eq!(w.triangle(h.slot), h.v);
                     let p = h.v[0] * h.b[0] + h.v[1] * h.b[1] + h.v[2] * h.b[2];
-                    assert!((p - ray.at(h.t)).length() <= 1e-4 * scale * (1.0 + h.t / scale), "ray {i}: {p} vs {}", ray.at(h.t));
+                    assert!(
+                        (p - ray.at(h.t)).length() <= 1e-4 * scale * (1.0 + h.t / scale),
+                        "ray {i}: {p} vs {}",
+                        ray.at(h.t)
+                    );
                 }
                 other => panic!("ray {i}: brute force {:?} vs wide bvh {:?}", other.0, other.1),
             }
@@ -500,7 +506,11 @@ mod tests {
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let t = pool.install(|| WideBvh::build_with_threshold(&v, 64));
-            assert_eq!((&t.nodes, &t.blocks, &t.block_first, &t.order), (&reference.nodes, &reference.blocks, &reference.block_first, &reference.order), "{threads} threads");
+            assert_eq!(
+                (&t.nodes, &t.blocks, &t.block_first, &t.order),
+                (&reference.nodes, &reference.blocks, &reference.block_first, &reference.order),
+                "{threads} threads"
+            );
         }
         let serial = WideBvh::build_with_threshold(&v, usize::MAX);
         assert_eq!((serial.nodes, serial.blocks, serial.root), (reference.nodes, reference.blocks, reference.root));
@@ -521,14 +531,18 @@ mod tests {
         let mut tris = soup(200, 9);
         for i in (0..200).step_by(3) {
             let p = tris[i].v0;
-            tris[i] = if i % 2 == 0 { Triangle::new(p, p, p) } else { Triangle::new(p, p + Vec3::X, p + Vec3::X * 2.0) };
+            tris[i] =
+                if i % 2 == 0 { Triangle::new(p, p, p) } else { Triangle::new(p, p + Vec3::X, p + Vec3::X * 2.0) };
         }
         let w = WideBvh::build(&verts(&tris));
         check_against_brute_force(&tris, &w, 1.0, 2000, 10);
-        // A tree as deep as the build allows: boxes that grow geometrically make the SAH
-        // peel one triangle per level; 1000 identical triangles force median splits.
+        // Deep trees: boxes that grow geometrically make the SAH peel a few triangles per
+        // level; 1000 identical triangles force median splits.
         // A NaN ray enters every box, so it pushes every child: the stack must hold.
-        let nan = [Ray { origin: Vec3::new(f32::NAN, 0.0, 0.0), dir: Vec3::Z }, Ray { origin: Vec3::ZERO, dir: Vec3::new(0.0, f32::NAN, 1.0) }];
+        let nan = [
+            Ray { origin: Vec3::new(f32::NAN, 0.0, 0.0), dir: Vec3::Z },
+            Ray { origin: Vec3::ZERO, dir: Vec3::new(0.0, f32::NAN, 1.0) },
+        ];
         let deep: Vec<[Vec3; 3]> = (0..3000)
             .map(|i| {
                 let s = 1.02f32.powi(i);
@@ -536,7 +550,8 @@ mod tests {
             })
             .collect();
         let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 1000];
-        let probes = [(Ray::new(Vec3::new(-1.0, 0.1, 0.1), Vec3::X), 2.0), (Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z), 1.0)];
+        let probes =
+            [(Ray::new(Vec3::new(-1.0, 0.1, 0.1), Vec3::X), 2.0), (Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z), 1.0)];
         for (tris, (probe, t)) in [deep, same].into_iter().zip(probes) {
             let w = WideBvh::build(&tris);
             let lv = levels(&w, w.root);
