@@ -16,6 +16,10 @@
 //! parent node, so a binary tree of depth below [`BINARY_DEPTH`] gives at most
 //! `BINARY_DEPTH / 2` node levels, and three pending siblings per level fit [`STACK`].
 
+// Lane loops `for l in 0..4` index several arrays by lane on purpose: that is the form the
+// compiler vectorises.
+#![allow(clippy::needless_range_loop)]
+
 use super::build::{Limits, build_tree};
 use super::tri4::Tri4;
 use super::{Node, PARALLEL_THRESHOLD, ROBUST};
@@ -137,7 +141,8 @@ impl RayBox4 {
 
 impl WideBvh {
     /// Builds over triangles given by their vertices (binned SAH on their boxes, in
-    /// parallel above 64k triangles, then collapsed). At most [`MAX_BLOCKS`] blocks.
+    /// parallel above 64k triangles, then collapsed). At most 2^28 - 1 blocks (meshes
+    /// check this when they load).
     pub fn build(tris: &[[Vec3; 3]]) -> WideBvh {
         Self::build_with_threshold(tris, PARALLEL_THRESHOLD)
     }
