@@ -1,14 +1,13 @@
 //! Triangle meshes: loading (through [`crate::io::mesh_file`]: .obj, .ply, either
 //! optionally gzip-compressed), placement by a [`Transform`], and intersection through the
-//! mesh's own [`Bvh`]. Triangles are stored in BVH leaf order, so the triangles of
-//! a leaf are contiguous in memory; `Hit::prim` is a triangle's index in that order.
+//! mesh's own [`WideBvh`], which also stores the triangles (four to a block, in leaf
+//! order); `Hit::prim` is a triangle's index in that order (its slot).
 
 use std::path::Path;
 
 use glam::{Mat3, Vec3};
 
-use super::bvh::Bvh;
-use super::triangle::TriRay;
+use super::bvh::{MAX_BLOCKS, TriangleHit, WideBvh};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::io::{MeshData, read_mesh_file};
@@ -50,23 +49,14 @@ impl Transform {
 /// A triangle mesh with optional per-vertex normals and its own BVH.
 #[derive(Clone, Debug)]
 pub struct Mesh {
-    /// Vertices of each triangle, in BVH slot order.
-    tris: Vec<[Vec3; 3]>,
     /// Vertex indices of each triangle (slot order), kept only with normals.
     normal_idx: Vec<[u32; 3]>,
     /// Unit per-vertex normals, if the file had them.
     normals: Option<Vec<Vec3>>,
-    bvh: Bvh,
+    /// The BVH, which holds the vertices of each triangle in slot order.
+    bvh: WideBvh,
     /// Input triangle indices of the dropped zero-area triangles, ascending.
     dropped: Vec<u32>,
-}
-
-/// Barycentric payload of a mesh hit, turned into a [`Hit`] once the closest is known.
-#[derive(Clone, Copy)]
-struct TriHit {
-    k: u32,
-    t: f32,
-    b: [f32; 3],
 }
 
 impl Mesh {
@@ -172,56 +162,45 @@ impl Mesh {
         if kept.is_empty() {
             return Err(err(format!("no valid triangles ({} given, {} of zero area)", indices.len(), dropped.len())));
         }
-        let bounds: Vec<Aabb> = kept
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| positions[i as usize]);
-                Aabb::new(a, b).grow(c)
-            })
-            .collect();
-        let bvh = Bvh::build(&bounds);
+        if kept.len() > MAX_BLOCKS {
+            return Err(err(format!("{} triangles: at most {MAX_BLOCKS} are supported", kept.len())));
+        }
+        let tris: Vec<[Vec3; 3]> = kept.iter().map(|t| t.map(|i| positions[i as usize])).collect();
+        let bvh = WideBvh::build(&tris);
+        drop(tris);
         let order = bvh.prim_order();
-        let tris = order.iter().map(|&i| kept[i as usize].map(|v| positions[v as usize])).collect();
         let normal_idx = if normals.is_some() { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
-        Ok(Mesh { tris, normal_idx, normals, bvh, dropped })
+        Ok(Mesh { normal_idx, normals, bvh, dropped })
     }
 
     /// Closest hit with `0 < t < t_max`. `prim` is the triangle's index in storage order.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let tr = TriRay::new(ray);
-        let h = self.bvh.intersect(ray, t_max, |k, t_max| {
-            let [p0, p1, p2] = self.tris[k as usize];
-            tr.intersect(p0, p1, p2, t_max).map(|(t, b0, b1, b2)| (t, TriHit { k, t, b: [b0, b1, b2] }))
-        })?;
+        let h = self.bvh.intersect(ray, t_max)?;
         Some(self.make_hit(&h))
     }
 
-    fn make_hit(&self, h: &TriHit) -> Hit {
-        let [p0, p1, p2] = self.tris[h.k as usize];
+    fn make_hit(&self, h: &TriangleHit) -> Hit {
+        let [p0, p1, p2] = h.v;
         let [b0, b1, b2] = h.b;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
         let n = (p1 - p0).cross(p2 - p0).normalize();
         let mut ns = n;
         if let Some(normals) = &self.normals {
-            let [i0, i1, i2] = self.normal_idx[h.k as usize];
+            let [i0, i1, i2] = self.normal_idx[h.slot as usize];
             let s = normals[i0 as usize] * b0 + normals[i1 as usize] * b1 + normals[i2 as usize] * b2;
             let s = s.normalize_or_zero();
             if s != Vec3::ZERO {
                 ns = if s.dot(n) < 0.0 { -s } else { s };
             }
         }
-        Hit { t: h.t, p, n, ns, prim: h.k }
+        Hit { t: h.t, p, n, ns, prim: h.slot }
     }
 
     /// True if any triangle blocks the ray with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let tr = TriRay::new(ray);
-        self.bvh.occluded(ray, t_max, |k, t_max| {
-            let [p0, p1, p2] = self.tris[k as usize];
-            tr.intersect(p0, p1, p2, t_max).is_some()
-        })
+        self.bvh.occluded(ray, t_max)
     }
 
     /// Bounding box.
@@ -231,7 +210,7 @@ impl Mesh {
 
     /// Number of (non-degenerate) triangles.
     pub fn triangle_count(&self) -> usize {
-        self.tris.len()
+        self.bvh.prim_order().len()
     }
 
     /// Number of zero-area triangles dropped at load.
@@ -240,14 +219,14 @@ impl Mesh {
     }
 
     /// The mesh's BVH (its slots are the triangle indices of [`Mesh::triangle`]).
-    pub fn bvh(&self) -> &Bvh {
+    pub fn bvh(&self) -> &WideBvh {
         &self.bvh
     }
 
     /// The vertices of triangle `prim` (storage order, as in `Hit::prim`), e.g. for
     /// sampling mesh lights. Panics if `prim >= triangle_count()` (a programming error).
     pub fn triangle(&self, prim: u32) -> [Vec3; 3] {
-        self.tris[prim as usize]
+        self.bvh.triangle(prim)
     }
 
     /// Index of triangle `prim` among the valid triangles in file order.

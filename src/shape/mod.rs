@@ -22,7 +22,7 @@ mod sphere;
 mod triangle;
 
 pub use bubble::Bubble;
-pub use bvh::Bvh;
+pub use bvh::{Bvh, TriangleHit, WideBvh};
 pub use cuboid::Cuboid;
 pub use disk::Disk;
 pub use mesh::{Mesh, Transform};

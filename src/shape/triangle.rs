@@ -22,13 +22,13 @@ pub struct Triangle {
 /// Per-ray data of the watertight test: the axis permutation and the shear.
 #[derive(Clone, Copy, Debug)]
 pub struct TriRay {
-    origin: Vec3,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    pub(super) origin: Vec3,
+    pub(super) kx: usize,
+    pub(super) ky: usize,
+    pub(super) kz: usize,
+    pub(super) sx: f32,
+    pub(super) sy: f32,
+    pub(super) sz: f32,
 }
 
 impl TriRay {

@@ -6,8 +6,11 @@
 //!
 //! The BVH knows nothing of the primitives themselves: traversal calls back with
 //! the slot `k` of each primitive in a visited leaf. [`Bvh::prim_order`] maps slots
-//! to indices in the slice the tree was built from; meshes store their triangles
-//! in slot order so that leaves are contiguous in memory.
+//! to indices in the slice the tree was built from. Scenes use it over their shapes.
+//!
+//! Meshes use [`WideBvh`] instead (`wide.rs`): the same build (`build.rs`), collapsed
+//! into 4-wide nodes whose leaves hold the triangles themselves, four to a block
+//! (`tri4.rs`), in this tree's slot order.
 
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -15,18 +18,19 @@
 use crate::geometry::{Aabb, Ray, gamma};
 use glam::Vec3;
 
-/// Number of SAH bins per axis.
-const BINS: usize = 16;
-/// Largest leaf the SAH may choose.
-const MAX_LEAF: usize = 8;
+mod build;
+mod tri4;
+mod wide;
+
+pub(crate) use wide::MAX_BLOCKS;
+pub use wide::{TriangleHit, WideBvh};
+
+use build::{Limits, build_tree};
+
 /// Node sizes above which the two children are built in parallel.
 const PARALLEL_THRESHOLD: usize = 64 * 1024;
 /// Traversal stack depth; the build keeps the tree shallower than this.
 const STACK: usize = 64;
-/// SAH cost of visiting a node, relative to intersecting one primitive, for the build:
-/// a node visit (two box tests, likely a cache miss) costs about two triangle tests
-/// (the triangles of a leaf are contiguous, so the next ones are cheap to fetch).
-const TRAVERSAL_COST: f32 = 2.0;
 /// Traversal cost of [`Bvh::sah_cost`], the usual 1 so that reports stay comparable.
 const REPORT_TRAVERSAL_COST: f32 = 1.0;
 
@@ -34,39 +38,28 @@ const REPORT_TRAVERSAL_COST: f32 = 1.0;
 /// the next index and their second at `offset`; leaves hold slots `offset..offset+count`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
-struct Node {
+pub(super) struct Node {
     /// Box planes: min x, y, z then max x, y, z (indexable by the ray's direction signs).
-    b: [f32; 6],
-    offset: u32,
-    count: u16,
-    axis: u8,
+    pub(super) b: [f32; 6],
+    /// First slot (leaf) or index of the second child (interior).
+    pub(super) offset: u32,
+    /// Number of slots of a leaf; 0 for an interior node.
+    pub(super) count: u16,
+    /// Split axis of an interior node.
+    pub(super) axis: u8,
     _pad: u8,
 }
 
 impl Node {
     #[inline]
-    fn new(bounds: Aabb, offset: u32, count: u16) -> Node {
+    pub(super) fn new(bounds: Aabb, offset: u32, count: u16) -> Node {
         let (lo, hi) = (bounds.min, bounds.max);
         Node { b: [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z], offset, count, axis: 0, _pad: 0 }
     }
 
     #[inline]
-    fn aabb(&self) -> Aabb {
+    pub(super) fn aabb(&self) -> Aabb {
         Aabb { min: Vec3::new(self.b[0], self.b[1], self.b[2]), max: Vec3::new(self.b[3], self.b[4], self.b[5]) }
-    }
-}
-
-/// A primitive during the build: its box and its index in the input slice.
-#[derive(Clone, Copy, Debug)]
-struct BuildPrim {
-    bounds: Aabb,
-    index: u32,
-}
-
-impl BuildPrim {
-    #[inline]
-    fn centroid(&self) -> Vec3 {
-        self.bounds.centroid()
     }
 }
 
@@ -86,7 +79,7 @@ struct RayBox {
 
 /// Factor applied to the far slab distances so that rounding never makes a ray miss a
 /// box that it grazes or a primitive lying exactly on a box face (pbrt's 1 + 2 gamma(3)).
-const ROBUST: f32 = 1.0 + 2.0 * gamma(3);
+pub(super) const ROBUST: f32 = 1.0 + 2.0 * gamma(3);
 
 impl RayBox {
     #[inline(always)]
@@ -144,14 +137,9 @@ impl Bvh {
     }
 
     fn build_with_threshold(prim_bounds: &[Aabb], threshold: usize) -> Bvh {
-        let mut prims: Vec<BuildPrim> =
-            prim_bounds.iter().enumerate().map(|(i, b)| BuildPrim { bounds: *b, index: i as u32 }).collect();
-        let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
-        if !prims.is_empty() {
-            build_node(&mut prims, 0, 0, &mut nodes, threshold);
-        }
-        nodes.shrink_to_fit();
-        Bvh { nodes, order: prims.iter().map(|p| p.index).collect() }
+        let (nodes, order) =
+            build_tree(prim_bounds.len(), |i| prim_bounds[i], Limits { threshold, max_depth: STACK as u32 });
+        Bvh { nodes, order }
     }
 
     /// Primitive order of the leaves: leaf ranges index into this; `prim_order()[k]` is an
@@ -305,185 +293,6 @@ impl Bvh {
     }
 }
 
-/// Smallest `k` with `2^k >= n`.
-fn ceil_log2(n: usize) -> u32 {
-    usize::BITS - n.saturating_sub(1).leading_zeros()
-}
-
-#[derive(Clone, Copy)]
-struct Bin {
-    bounds: Aabb,
-    count: u32,
-}
-
-/// Bin of centroid coordinate `c` (same formula for binning and partitioning).
-#[inline(always)]
-fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
-    (((c - lo) * scale) as usize).min(BINS - 1)
-}
-
-/// Builds the subtree over `prims` (slots `first..first + prims.len()`), appending its
-/// nodes depth-first to `nodes`; node offsets are relative to the start of `nodes`.
-fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<Node>, threshold: usize) {
-    let n = prims.len();
-    let mut bounds = Aabb::EMPTY;
-    let mut cb = Aabb::EMPTY;
-    for p in prims.iter() {
-        bounds = bounds.union(&p.bounds);
-        cb = cb.grow(p.centroid());
-    }
-    let me = nodes.len();
-    nodes.push(Node::new(bounds, first, n as u16));
-    if n == 1 {
-        return;
-    }
-
-    let extent = cb.diagonal();
-    // Too deep for the traversal stack if SAH keeps peeling: fall back to median splits,
-    // which finish in ceil(log2 n) more levels.
-    let force_median = depth + ceil_log2(n) + 2 >= STACK as u32;
-    let mut split: Option<(usize, usize)> = None; // (axis, last bin on the left)
-    if !force_median {
-        let mut bins = [[Bin { bounds: Aabb::EMPTY, count: 0 }; BINS]; 3];
-        let mut scale = [0.0f32; 3];
-        for a in 0..3 {
-            if extent[a] > 0.0 {
-                scale[a] = BINS as f32 / extent[a];
-            }
-        }
-        for p in prims.iter() {
-            let c = p.centroid();
-            for a in 0..3 {
-                let b = &mut bins[a][bin_of(c[a], cb.min[a], scale[a])];
-                b.count += 1;
-                b.bounds = b.bounds.union(&p.bounds);
-            }
-        }
-        let mut best_cost = f32::INFINITY;
-        for a in 0..3 {
-            if !(extent[a] > 0.0) {
-                continue;
-            }
-            // Right-to-left sweep: area * count of the right part for each split.
-            let mut right = [0.0f32; BINS];
-            let mut rb = Aabb::EMPTY;
-            let mut rc = 0u32;
-            for i in (1..BINS).rev() {
-                rb = rb.union(&bins[a][i].bounds);
-                rc += bins[a][i].count;
-                right[i - 1] = rb.surface_area() * rc as f32;
-            }
-            let mut lb = Aabb::EMPTY;
-            let mut lc = 0u32;
-            for i in 0..BINS - 1 {
-                lb = lb.union(&bins[a][i].bounds);
-                lc += bins[a][i].count;
-                if lc == 0 || lc as usize == n {
-                    continue;
-                }
-                let cost = lb.surface_area() * lc as f32 + right[i];
-                if cost < best_cost {
-                    best_cost = cost;
-                    split = Some((a, i));
-                }
-            }
-        }
-        let area = bounds.surface_area();
-        let split_cost = if area > 0.0 { TRAVERSAL_COST + best_cost / area } else { f32::INFINITY };
-        if n <= MAX_LEAF && (n as f32) <= split_cost {
-            return;
-        }
-        if split.is_none() && n <= MAX_LEAF {
-            return;
-        }
-    } else if n <= MAX_LEAF {
-        return;
-    }
-
-    let (mid, axis) = match split {
-        Some((a, last)) => {
-            let (lo, scale) = (cb.min[a], BINS as f32 / extent[a]);
-            let mid = partition(prims, |p| bin_of(p.centroid()[a], lo, scale) <= last);
-            (mid, a)
-        }
-        None => {
-            // Median split on the widest centroid axis, ties broken by index.
-            let a = if extent.x >= extent.y && extent.x >= extent.z {
-                0
-            } else if extent.y >= extent.z {
-                1
-            } else {
-                2
-            };
-            let mid = n / 2;
-            prims.select_nth_unstable_by(mid, |p, q| {
-                p.centroid()[a].total_cmp(&q.centroid()[a]).then(p.index.cmp(&q.index))
-            });
-            (mid, a)
-        }
-    };
-    let (left, right) = prims.split_at_mut(mid);
-    let second = if n > threshold {
-        let (ln, rn) = rayon::join(
-            || {
-                let mut v = Vec::new();
-                build_node(left, first, depth + 1, &mut v, threshold);
-                v
-            },
-            || {
-                let mut v = Vec::new();
-                build_node(right, first + mid as u32, depth + 1, &mut v, threshold);
-                v
-            },
-        );
-        append(nodes, ln);
-        let second = nodes.len();
-        append(nodes, rn);
-        second
-    } else {
-        build_node(left, first, depth + 1, nodes, threshold);
-        let second = nodes.len();
-        build_node(right, first + mid as u32, depth + 1, nodes, threshold);
-        second
-    };
-    let node = &mut nodes[me];
-    node.offset = second as u32;
-    node.count = 0;
-    node.axis = axis as u8;
-}
-
-/// Appends a subtree built in its own vector, shifting its interior links.
-fn append(nodes: &mut Vec<Node>, sub: Vec<Node>) {
-    let base = nodes.len() as u32;
-    nodes.extend(sub.into_iter().map(|mut n| {
-        if n.count == 0 {
-            n.offset += base;
-        }
-        n
-    }));
-}
-
-/// Stable-in-outcome, in-place two-way partition; returns the number of elements for
-/// which `left` holds (they come first).
-fn partition(prims: &mut [BuildPrim], left: impl Fn(&BuildPrim) -> bool) -> usize {
-    let mut i = 0;
-    let mut j = prims.len();
-    loop {
-        while i < j && left(&prims[i]) {
-            i += 1;
-        }
-        while i < j && !left(&prims[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        prims.swap(i, j - 1);
-        i += 1;
-        j -= 1;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -491,7 +300,8 @@ mod tests {
     use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
 
-    fn soup(n: usize, seed: u64) -> Vec<Triangle> {
+    /// `n` random triangles of random sizes in a 10-unit cube.
+    pub(super) fn soup(n: usize, seed: u64) -> Vec<Triangle> {
         let mut rng = Pcg32::new(seed, 1);
         let mut v = || Vec3::new(uniform(&mut rng), uniform(&mut rng), uniform(&mut rng));
         (0..n)

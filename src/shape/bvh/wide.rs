@@ -1,0 +1,570 @@
+//! The triangle BVH of meshes: 4-wide nodes of one 128-byte, cache-line-aligned block
+//! (the four children's boxes as `[min/max][axis][lane]` arrays of `f32`, then the four
+//! child references), leaves of [`Tri4`] blocks, closest-hit traversal that enters the
+//! nearest child first, and any-hit traversal for shadow rays.
+//!
+//! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
+//! grandchildren (or, beside a leaf child, its other child's children, then the children
+//! of the largest of those), and a subtree of at most four triangles becomes one leaf
+//! block. Leaves keep the binary tree's slot order, so the triangles' storage order (and
+//! `Hit::prim`) is the binary tree's; the tree is as deterministic as that build.
+//!
+//! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
+//! under 32 bytes per triangle, the vertices live in the blocks.
+//!
+//! Traversal stack: every node below the root sits at least two binary levels under its
+//! parent node, so a binary tree of depth below [`BINARY_DEPTH`] gives at most
+//! `BINARY_DEPTH / 2` node levels, and three pending siblings per level fit [`STACK`].
+
+// Lane loops `for l in 0..4` index several arrays by lane on purpose: that is the form the
+// compiler vectorises.
+#![allow(clippy::needless_range_loop)]
+
+use super::build::{Limits, build_tree};
+use super::tri4::Tri4;
+use super::{Node, PARALLEL_THRESHOLD, ROBUST};
+use crate::geometry::{Aabb, Ray};
+use crate::shape::triangle::TriRay;
+use glam::Vec3;
+
+/// Depth limit of the binary tree that is collapsed (see the module doc).
+const BINARY_DEPTH: u32 = 42;
+/// Traversal stack entries: three pending children per node level, plus one.
+const STACK: usize = 3 * (BINARY_DEPTH as usize / 2) + 1;
+/// Reference flag of a leaf; its bits 28-30 hold the block count minus one and bits
+/// 0-27 the first block.
+const LEAF: u32 = 1 << 31;
+/// Mask of a leaf's first block.
+const BLOCK_MASK: u32 = (1 << 28) - 1;
+/// An unused child slot.
+const EMPTY: u32 = u32::MAX;
+/// Most blocks a mesh can have (the rest of a reference's bits).
+pub(crate) const MAX_BLOCKS: usize = BLOCK_MASK as usize;
+
+/// Four children: boxes as `b[0 = min, 1 = max][axis][lane]`, then their references
+/// (a node index, a leaf, or [`EMPTY`] with an empty box).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+struct Node4 {
+    b: [[[f32; 4]; 3]; 2],
+    child: [u32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<Node4>() == 128 && std::mem::size_of::<Tri4>() == 144);
+
+impl Node4 {
+    const EMPTY: Node4 = Node4 { b: [[[f32::INFINITY; 4]; 3], [[f32::NEG_INFINITY; 4]; 3]], child: [EMPTY; 4] };
+
+    fn set(&mut self, lane: usize, bounds: Aabb, child: u32) {
+        for a in 0..3 {
+            self.b[0][a][lane] = bounds.min[a];
+            self.b[1][a][lane] = bounds.max[a];
+        }
+        self.child[lane] = child;
+    }
+
+    fn child_box(&self, lane: usize) -> Aabb {
+        let b = &self.b;
+        Aabb {
+            min: Vec3::new(b[0][0][lane], b[0][1][lane], b[0][2][lane]),
+            max: Vec3::new(b[1][0][lane], b[1][1][lane], b[1][2][lane]),
+        }
+    }
+}
+
+/// The closest triangle a ray hits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    /// The triangle's slot (its index in storage order, see [`WideBvh::prim_order`]).
+    pub slot: u32,
+    /// Distance along the ray.
+    pub t: f32,
+    /// Barycentric weights of the three vertices.
+    pub b: [f32; 3],
+    /// The triangle's vertices.
+    pub v: [Vec3; 3],
+}
+
+/// A 4-wide BVH that stores its triangles (see the module doc).
+#[derive(Clone, Debug)]
+pub struct WideBvh {
+    nodes: Vec<Node4>,
+    blocks: Vec<Tri4>,
+    /// Slot of each block's lane 0; the other lanes follow.
+    block_first: Vec<u32>,
+    /// Input index of each slot.
+    order: Vec<u32>,
+    root: u32,
+    bounds: Aabb,
+}
+
+/// Per-ray data of the 4-wide slab test.
+struct RayBox4 {
+    o: [f32; 3],
+    inv: [f32; 3],
+    neg: [usize; 3],
+}
+
+impl RayBox4 {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayBox4 {
+        // As in the binary tree: 1/±0 = ±inf, NaN slab values are ignored.
+        let inv = (Vec3::ONE / ray.dir).to_array();
+        RayBox4 { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
+    }
+
+    /// Entry distance into each child's box if the ray hits it with `t` in `[0, t_max]`,
+    /// else infinity: the binary tree's slab test, lane by lane.
+    #[inline(always)]
+    fn entry(&self, n: &Node4, t_max: f32) -> [f32; 4] {
+        let mut t0 = [0.0f32; 4];
+        let mut t1 = [t_max; 4];
+        for a in 0..3 {
+            let near = &n.b[self.neg[a]][a];
+            let far = &n.b[1 - self.neg[a]][a];
+            let (o, inv) = (self.o[a], self.inv[a]);
+            for l in 0..4 {
+                let ta = (near[l] - o) * inv;
+                let tb = (far[l] - o) * inv * ROBUST;
+                // Written so that a NaN slab value leaves t0/t1 unchanged (maxps/minps).
+                t0[l] = if ta > t0[l] { ta } else { t0[l] };
+                t1[l] = if tb < t1[l] { tb } else { t1[l] };
+            }
+        }
+        let mut e = [f32::INFINITY; 4];
+        for l in 0..4 {
+            e[l] = if t0[l] <= t1[l] { t0[l] } else { f32::INFINITY };
+        }
+        e
+    }
+}
+
+impl WideBvh {
+    /// Builds over triangles given by their vertices (binned SAH on their boxes, in
+    /// parallel above 64k triangles, then collapsed). At most 2^28 - 1 blocks (meshes
+    /// check this when they load).
+    pub fn build(tris: &[[Vec3; 3]]) -> WideBvh {
+        Self::build_with_threshold(tris, PARALLEL_THRESHOLD)
+    }
+
+    fn build_with_threshold(tris: &[[Vec3; 3]], threshold: usize) -> WideBvh {
+        let limits = Limits { threshold, max_depth: BINARY_DEPTH };
+        let (bin, order) = build_tree(tris.len(), |i| Aabb::new(tris[i][0], tris[i][1]).grow(tris[i][2]), limits);
+        // Slot range (first, count) of every binary subtree; children follow their parent.
+        let mut range = vec![(0u32, 0u32); bin.len()];
+        for i in (0..bin.len()).rev() {
+            let n = &bin[i];
+            range[i] = if n.count > 0 {
+                (n.offset, n.count as u32)
+            } else {
+                (range[i + 1].0, range[i + 1].1 + range[n.offset as usize].1)
+            };
+        }
+        let mut w = WideBvh {
+            nodes: Vec::with_capacity(tris.len() / 6 + 1),
+            blocks: Vec::with_capacity(tris.len() / 2 + 1),
+            block_first: Vec::with_capacity(tris.len() / 2 + 1),
+            order: Vec::new(),
+            root: EMPTY,
+            bounds: bin.first().map_or(Aabb::EMPTY, |n| n.aabb()),
+        };
+        if !bin.is_empty() {
+            let mut c = Collapse { bin: &bin, range: &range, tris, order: &order, out: &mut w };
+            w.root = c.subtree(0);
+        }
+        w.order = order;
+        w.nodes.shrink_to_fit();
+        w.blocks.shrink_to_fit();
+        w.block_first.shrink_to_fit();
+        w
+    }
+
+    /// Slot order: `prim_order()[slot]` is the triangle's index in the slice given to
+    /// [`WideBvh::build`].
+    pub fn prim_order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// Bounds of everything (empty for an empty tree).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// Number of 4-wide nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Number of four-triangle blocks.
+    pub fn block_count(&self) -> usize {
+        self.blocks.len()
+    }
+
+    /// Bytes of the nodes and the index data (each block's first slot, the slot order);
+    /// the vertices are [`WideBvh::triangle_bytes`].
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * size_of::<Node4>() + (self.block_first.len() + self.order.len()) * 4
+    }
+
+    /// Bytes of the triangle blocks (the vertices, unused lanes included).
+    pub fn triangle_bytes(&self) -> usize {
+        self.blocks.len() * size_of::<Tri4>()
+    }
+
+    /// The vertices of the triangle in `slot`; panics if `slot >= prim_order().len()`.
+    pub fn triangle(&self, slot: u32) -> [Vec3; 3] {
+        let b = self.block_first.partition_point(|&f| f <= slot) - 1;
+        self.blocks[b].triangle((slot - self.block_first[b]) as usize)
+    }
+
+    /// SAH cost of the tree for reports: visiting a node costs 1, testing a block 1, each
+    /// weighted by the area of its box relative to the root's.
+    pub fn sah_cost(&self) -> f32 {
+        let area = |b: Aabb| b.surface_area() as f64;
+        let root_area = area(self.bounds);
+        if self.root == EMPTY || !(root_area > 0.0) {
+            return 0.0;
+        }
+        let cost = |r: u32| if r & LEAF == 0 { 1.0 } else { (((r >> 28) & 7) + 1) as f64 };
+        let mut total = cost(self.root) * root_area;
+        for n in &self.nodes {
+            for l in 0..4 {
+                if n.child[l] != EMPTY {
+                    total += cost(n.child[l]) * area(n.child_box(l));
+                }
+            }
+        }
+        (total / root_area) as f32
+    }
+
+    /// Closest hit with `0 < t < t_max`. Children whose boxes the ray enters are visited
+    /// nearest first; pending ones are skipped once a hit lies in front of them. Ties
+    /// between triangles at the same `t` go to the first one found.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
+        if self.root == EMPTY {
+            return None;
+        }
+        let rb = RayBox4::new(ray);
+        let tr = TriRay::new(ray);
+        let mut t_max = t_max;
+        let mut best = None;
+        let mut stack = [(0u32, 0.0f32); STACK];
+        let mut sp = 0usize;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let e = rb.entry(node, t_max);
+                // Hit children, then sorted farthest first: the nearest is visited now.
+                let mut c = [(0.0f32, 0u32); 4];
+                let mut n = 0;
+                for l in 0..4 {
+                    if e[l] < f32::INFINITY && node.child[l] != EMPTY {
+                        c[n] = (e[l], node.child[l]);
+                        n += 1;
+                    }
+                }
+                if n > 0 {
+                    for i in 1..n {
+                        let x = c[i];
+                        let mut j = i;
+                        while j > 0 && c[j - 1].0 < x.0 {
+                            c[j] = c[j - 1];
+                            j -= 1;
+                        }
+                        c[j] = x;
+                    }
+                    for &x in &c[..n - 1] {
+                        stack[sp] = (x.1, x.0);
+                        sp += 1;
+                    }
+                    cur = c[n - 1].1;
+                    continue;
+                }
+            } else {
+                let first = (cur & BLOCK_MASK) as usize;
+                for b in first..=first + ((cur >> 28) & 7) as usize {
+                    let ts = self.blocks[b].hit_t(&tr, t_max);
+                    for (l, &t) in ts.iter().enumerate() {
+                        if t < t_max {
+                            t_max = t;
+                            best = Some((b, l));
+                        }
+                    }
+                }
+            }
+            // Pop the next child still in front of the closest hit.
+            loop {
+                if sp == 0 {
+                    let (b, l) = best?;
+                    let v = self.blocks[b].triangle(l);
+                    let (t, b0, b1, b2) = tr.intersect(v[0], v[1], v[2], f32::INFINITY)?;
+                    debug_assert_eq!(t, t_max);
+                    return Some(TriangleHit { slot: self.block_first[b] + l as u32, t, b: [b0, b1, b2], v });
+                }
+                sp -= 1;
+                let (r, t) = stack[sp];
+                if t < t_max {
+                    cur = r;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// True if any triangle blocks the ray with `0 < t < t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.root == EMPTY {
+            return false;
+        }
+        let rb = RayBox4::new(ray);
+        let tr = TriRay::new(ray);
+        let mut stack = [0u32; STACK];
+        stack[0] = self.root;
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let cur = stack[sp];
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let e = rb.entry(node, t_max);
+                for l in 0..4 {
+                    if e[l] < f32::INFINITY && node.child[l] != EMPTY {
+                        stack[sp] = node.child[l];
+                        sp += 1;
+                    }
+                }
+            } else {
+                let first = (cur & BLOCK_MASK) as usize;
+                for b in first..=first + ((cur >> 28) & 7) as usize {
+                    if self.blocks[b].hit_t(&tr, t_max).iter().any(|&t| t < t_max) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
+/// State of the collapse of a binary tree into [`WideBvh`] nodes.
+struct Collapse<'a> {
+    bin: &'a [Node],
+    range: &'a [(u32, u32)],
+    tris: &'a [[Vec3; 3]],
+    order: &'a [u32],
+    out: &'a mut WideBvh,
+}
+
+impl Collapse<'_> {
+    /// True if binary node `i` becomes a 4-wide node (not a leaf).
+    fn opens(&self, i: usize) -> bool {
+        self.bin[i].count == 0 && self.range[i].1 > 4
+    }
+
+    /// The reference of binary subtree `i`, appending its nodes and blocks depth first.
+    fn subtree(&mut self, i: usize) -> u32 {
+        let (first, count) = self.range[i];
+        if !self.opens(i) {
+            let start = self.out.blocks.len();
+            for j in (first..first + count).step_by(4) {
+                let n = (first + count - j).min(4) as usize;
+                let mut lanes = [[Vec3::ZERO; 3]; 4];
+                for (k, lane) in lanes[..n].iter_mut().enumerate() {
+                    *lane = self.tris[self.order[j as usize + k] as usize];
+                }
+                self.out.blocks.push(Tri4::new(&lanes[..n]));
+                self.out.block_first.push(j);
+            }
+            let nb = (self.out.blocks.len() - start) as u32;
+            debug_assert!((1..=8).contains(&nb) && start < MAX_BLOCKS);
+            return LEAF | (nb - 1) << 28 | start as u32;
+        }
+        // Children in slot order: two, then grandchildren (see the module doc).
+        let kids2 = |j: usize| [j + 1, self.bin[j].offset as usize];
+        let [l, r] = kids2(i);
+        let mut kids: Vec<usize> = match (self.opens(l), self.opens(r)) {
+            (true, true) => [kids2(l), kids2(r)].concat(),
+            (true, false) => [&kids2(l)[..], &[r]].concat(),
+            (false, true) => [&[l][..], &kids2(r)].concat(),
+            (false, false) => vec![l, r],
+        };
+        if kids.len() == 3 {
+            let area = |j: usize| self.bin[j].aabb().surface_area();
+            let pick = (0..3).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
+            if let Some(k) = pick {
+                let [a, b] = kids2(kids[k]);
+                kids.splice(k..=k, [a, b]);
+            }
+        }
+        let me = self.out.nodes.len();
+        self.out.nodes.push(Node4::EMPTY);
+        for (lane, &k) in kids.iter().enumerate() {
+            let r = self.subtree(k);
+            self.out.nodes[me].set(lane, self.bin[k].aabb(), r);
+        }
+        me as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::Triangle;
+    use crate::shape::bvh::tests::soup;
+    use crate::shape::sphere::tests::{random_dir, uniform};
+    use rand_pcg::Pcg32;
+
+    fn verts(tris: &[Triangle]) -> Vec<[Vec3; 3]> {
+        tris.iter().map(|t| [t.v0, t.v1, t.v2]).collect()
+    }
+
+    /// Node levels of the tree (0 for a tree that is one leaf).
+    fn levels(w: &WideBvh, r: u32) -> usize {
+        if r & LEAF != 0 {
+            return 0;
+        }
+        1 + w.nodes[r as usize].child.iter().filter(|&&c| c != EMPTY).map(|&c| levels(w, c)).max().unwrap_or(0)
+    }
+
+    /// Brute force over `tris` with the single-triangle test: (t, index) of the closest hit.
+    fn brute(tris: &[Triangle], ray: &Ray, t_max: f32) -> Option<(f32, u32)> {
+        tris.iter()
+            .enumerate()
+            .filter_map(|(k, t)| t.intersect(ray, t_max).map(|h| (h.t, k as u32)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
+    /// Closest and any hits of `w` against brute force on `n` rays through `tris`'s
+    /// region (scaled by `scale`); returns the number of hits.
+    fn check_against_brute_force(tris: &[Triangle], w: &WideBvh, scale: f32, n: usize, seed: u64) -> usize {
+        let mut rng = Pcg32::new(seed, 2);
+        let mut hits = 0;
+        for i in 0..n {
+            let o = (Vec3::new(uniform(&mut rng), uniform(&mut rng), uniform(&mut rng)) * 14.0 - 7.0) * scale;
+            let mut d = random_dir(&mut rng);
+            if i % 10 == 0 {
+                // Axis-parallel rays, including -0 components.
+                d = [Vec3::X, -Vec3::Y, Vec3::new(-0.0, 0.0, 1.0)][i / 10 % 3];
+            }
+            let ray = Ray::new(o, d);
+            let t_max = if i % 7 == 0 { 3.0 * scale } else { f32::INFINITY };
+            let want = brute(tris, &ray, t_max);
+            let got = w.intersect(&ray, t_max);
+            match (want, got) {
+                (None, None) => {}
+                (Some((t, k)), Some(h)) => {
+                    hits += 1;
+                    // The same arithmetic: the same t, bit for bit.
+                    assert_eq!(t.to_bits(), h.t.to_bits(), "ray {i}");
+                    let k_got = w.prim_order()[h.slot as usize];
+                    assert!(k == k_got || brute(&tris[k_got as usize..=k_got as usize], &ray, t_max).unwrap().0 == t);
+                    let tri = &tris[k_got as usize];
+                    assert_eq!(h.v, [tri.v0, tri.v1, tri.v2]);
+                    assert_eq!(w.triangle(h.slot), h.v);
+                    let p = h.v[0] * h.b[0] + h.v[1] * h.b[1] + h.v[2] * h.b[2];
+                    assert!(
+                        (p - ray.at(h.t)).length() <= 1e-4 * scale * (1.0 + h.t / scale),
+                        "ray {i}: {p} vs {}",
+                        ray.at(h.t)
+                    );
+                }
+                other => panic!("ray {i}: brute force {:?} vs wide bvh {:?}", other.0, other.1),
+            }
+            assert_eq!(w.occluded(&ray, t_max), want.is_some(), "ray {i}: occluded");
+        }
+        hits
+    }
+
+    #[test]
+    fn matches_brute_force_on_triangle_soup() {
+        let tris = soup(3000, 1);
+        let w = WideBvh::build(&verts(&tris));
+        assert!(w.sah_cost() > 1.0 && w.node_count() > 100);
+        let mut order = w.prim_order().to_vec();
+        order.sort();
+        assert!(order.iter().enumerate().all(|(i, &k)| i as u32 == k), "prim_order is a permutation");
+        let hits = check_against_brute_force(&tris, &w, 1.0, 10_000, 2);
+        assert!(hits > 2000, "test rays should hit often ({hits})");
+    }
+
+    #[test]
+    fn huge_and_tiny_coordinates() {
+        for scale in [1e-12f32, 1e9] {
+            let tris: Vec<Triangle> =
+                soup(500, 5).iter().map(|t| Triangle::new(t.v0 * scale, t.v1 * scale, t.v2 * scale)).collect();
+            let w = WideBvh::build(&verts(&tris));
+            let hits = check_against_brute_force(&tris, &w, scale, 2000, 6);
+            assert!(hits > 200, "scale {scale}: {hits} hits");
+        }
+    }
+
+    #[test]
+    fn same_slot_order_as_the_binary_tree_and_deterministic() {
+        let tris = soup(5000, 3);
+        let v = verts(&tris);
+        let reference = WideBvh::build_with_threshold(&v, 64);
+        let binary = super::super::Bvh::build(&tris.iter().map(|t| t.bounds()).collect::<Vec<_>>());
+        assert_eq!(reference.order, binary.prim_order(), "storage order unchanged by the collapse");
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let t = pool.install(|| WideBvh::build_with_threshold(&v, 64));
+            assert_eq!(
+                (&t.nodes, &t.blocks, &t.block_first, &t.order),
+                (&reference.nodes, &reference.blocks, &reference.block_first, &reference.order),
+                "{threads} threads"
+            );
+        }
+        let serial = WideBvh::build_with_threshold(&v, usize::MAX);
+        assert_eq!((serial.nodes, serial.blocks, serial.root), (reference.nodes, reference.blocks, reference.root));
+    }
+
+    #[test]
+    fn empty_degenerate_deep_and_nan() {
+        let empty = WideBvh::build(&[]);
+        let r = Ray::new(Vec3::ZERO, Vec3::X);
+        assert!(empty.intersect(&r, f32::INFINITY).is_none() && !empty.occluded(&r, f32::INFINITY));
+        assert_eq!((empty.sah_cost(), empty.memory_bytes()), (0.0, 0));
+        // One triangle: the root is a leaf.
+        let one = WideBvh::build(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+        let down = Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
+        assert_eq!(one.intersect(&down, f32::INFINITY).map(|h| h.t), Some(1.0));
+        assert!(one.occluded(&down, 1.5) && !one.occluded(&down, 0.5));
+        // Degenerate triangles (a point, a segment) among valid ones never hit.
+        let mut tris = soup(200, 9);
+        for i in (0..200).step_by(3) {
+            let p = tris[i].v0;
+            tris[i] =
+                if i % 2 == 0 { Triangle::new(p, p, p) } else { Triangle::new(p, p + Vec3::X, p + Vec3::X * 2.0) };
+        }
+        let w = WideBvh::build(&verts(&tris));
+        check_against_brute_force(&tris, &w, 1.0, 2000, 10);
+        // Deep trees: boxes that grow geometrically make the SAH peel a few triangles per
+        // level; 1000 identical triangles force median splits.
+        // A NaN ray enters every box, so it pushes every child: the stack must hold.
+        let nan = [
+            Ray { origin: Vec3::new(f32::NAN, 0.0, 0.0), dir: Vec3::Z },
+            Ray { origin: Vec3::ZERO, dir: Vec3::new(0.0, f32::NAN, 1.0) },
+        ];
+        let deep: Vec<[Vec3; 3]> = (0..3000)
+            .map(|i| {
+                let s = 1.02f32.powi(i);
+                [Vec3::new(s, 0.0, 0.0), Vec3::new(s, s, 0.0), Vec3::new(s, 0.0, s)]
+            })
+            .collect();
+        let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 1000];
+        let probes =
+            [(Ray::new(Vec3::new(-1.0, 0.1, 0.1), Vec3::X), 2.0), (Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z), 1.0)];
+        for (tris, (probe, t)) in [deep, same].into_iter().zip(probes) {
+            let w = WideBvh::build(&tris);
+            let lv = levels(&w, w.root);
+            assert!(lv >= 4 && 3 * lv < STACK, "{lv} levels");
+            for r in &nan {
+                assert!(w.intersect(r, f32::INFINITY).is_none() && !w.occluded(r, f32::INFINITY));
+            }
+            assert_eq!(w.intersect(&probe, f32::INFINITY).map(|h| h.t), Some(t));
+        }
+    }
+}
