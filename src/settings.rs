@@ -332,7 +332,9 @@ mod tests {
         assert!(p.set("width", "40000").unwrap_err().to_string().contains("at most 32768"));
         assert!(p.set("packet_size", "3").unwrap_err().to_string().contains("1, 2, 4 or 8"));
         assert!(p.set("seed", "-1").unwrap_err().to_string().contains("whole number"));
-        assert!(p.set("integrator", "bdpt").unwrap_err().to_string().contains("auto, path, whitted, spectral"));
+        assert!(p.set("integrator", "bdpt").is_ok());
+        let err = p.set("integrator", "photon").unwrap_err().to_string();
+        assert!(err.contains("auto, path, whitted, spectral, bdpt, lighttrace"), "{err}");
         assert!(p.set("focus", "1").is_err());
         assert_eq!(
             FIELDS.iter().map(|f| f.name).collect::<Vec<_>>(),
