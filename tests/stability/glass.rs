@@ -17,14 +17,7 @@ use super::*;
 /// packet samplers' colour noise is checked on the image mean (5 s.e.).
 #[test]
 fn camera_inside_glass_sees_n_squared_l() {
-    let scene = format!(
-        r#"(
-        camera: (eye: (0, 0, 0), look_at: (0.3, 0.2, -1), fov_deg: 60),
-        render: (width: 8, height: 8, max_bounces: 64),
-        materials: {{ "glass": Dielectric(ior: Constant(1.5)) }},
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"), {ENCLOSURE} ],
-    )"#
-    );
+    let scene = camera_in_glass();
     for m in METHODS {
         let film = render_str(&scene, &method(m, 32, 3));
         if m == "lighttrace" {

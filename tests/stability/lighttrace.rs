@@ -13,14 +13,7 @@ use super::*;
 /// errors (pixel spread at 64 spp) + 0.3%.
 #[test]
 fn lighttrace_lambertian_sphere_with_a_point_light_inside() {
-    let scene = r#"(
-        camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
-        render: (width: 12, height: 12, max_bounces: 10000),
-        materials: { "m": Lambertian(reflectance: Constant(0.5)) },
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m") ],
-        lights: [ Point(position: (0, 0, 0), intensity: Constant(1)) ],
-    )"#;
-    let film = render_str(scene, &method("lighttrace", 64, 1));
+    let film = render_str(POINT_IN_SPHERE, &method("lighttrace", 64, 1));
     let (mean, se) = mean_and_stderr(&film, 1);
     let want = 1.0 / std::f64::consts::PI;
     eprintln!("point light in sphere, lighttrace: Y = {mean:.5} ± {se:.5}, want {want:.5}");
@@ -32,13 +25,7 @@ fn lighttrace_lambertian_sphere_with_a_point_light_inside() {
 /// reflections: L_e = 1 instead of L_e / (1 − ρ) = 2. Within 5 s.e. + 1%.
 #[test]
 fn lighttrace_sees_no_mirror_reflections() {
-    let scene = r#"(
-        camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
-        render: (width: 8, height: 8, max_bounces: 40),
-        materials: { "m": Mirror(reflectance: Constant(0.5)) },
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m", emission: Constant(1), two_sided: true) ],
-    )"#;
-    let film = render_str(scene, &method("lighttrace", 256, 2));
+    let film = render_str(&mirror_enclosure(0.5), &method("lighttrace", 256, 2));
     let (mean, se) = mean_and_stderr(&film, 1);
     eprintln!("mirror furnace ρ 0.5, lighttrace: Y = {mean:.5} ± {se:.5}, want 1 (emission only)");
     assert!((mean - 1.0).abs() < 5.0 * se + 0.01, "Y = {mean} ± {se}");
@@ -49,15 +36,7 @@ fn lighttrace_sees_no_mirror_reflections() {
 /// n² L = 2.25), and no NaN.
 #[test]
 fn lighttrace_sees_nothing_through_glass() {
-    let scene = format!(
-        r#"(
-        camera: (eye: (0, 0, 0), look_at: (0.3, 0.2, -1), fov_deg: 60),
-        render: (width: 8, height: 8, max_bounces: 64),
-        materials: {{ "glass": Dielectric(ior: Constant(1.5)) }},
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"), {ENCLOSURE} ],
-    )"#
-    );
-    let film = render_str(&scene, &method("lighttrace", 16, 3));
+    let film = render_str(&camera_in_glass(), &method("lighttrace", 16, 3));
     assert!(y(&film).iter().all(|&v| v == 0.0), "light tracing cannot connect through smooth glass");
 }
 
@@ -70,16 +49,7 @@ fn lighttrace_sees_nothing_through_glass() {
 /// 5 standard errors (unbiased, however noisy), the plane is darker than 0.5.
 #[test]
 fn lighttrace_grazing_view_of_a_diffuse_plane() {
-    let scene = format!(
-        r#"(
-        camera: (eye: (0, 0.001, 0), look_at: (0, 0.001, -1), fov_deg: 2),
-        render: (width: 8, height: 8, max_bounces: 8),
-        materials: {{ "m": Lambertian(reflectance: Constant(0.5)) }},
-        objects: [ (shape: Plane(point: (0, 0, 0), normal: (0, 1, 0)), material: "m"), {} ],
-    )"#,
-        ENCLOSURE.replace("radius: 10", "radius: 1000")
-    );
-    let v = y(&render_str(&scene, &method("lighttrace", 256, 16)));
+    let v = y(&render_str(&grazing_plane(), &method("lighttrace", 256, 16)));
     let (plane, se) = mean_se(&v[40..]);
     let (sky, se_sky) = mean_se(&v[..32]);
     eprintln!(

@@ -64,6 +64,52 @@ fn mean_se(v: &[f64]) -> (f64, f64) {
     (m, (var / n).sqrt())
 }
 
+/// A Lambertian sphere (ρ 0.5, R 1) with a point light of intensity 1 at its centre.
+const POINT_IN_SPHERE: &str = r#"(
+        camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
+        render: (width: 12, height: 12, max_bounces: 10000),
+        materials: { "m": Lambertian(reflectance: Constant(0.5)) },
+        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m") ],
+        lights: [ Point(position: (0, 0, 0), intensity: Constant(1)) ],
+    )"#;
+
+/// A closed mirror sphere of reflectance `rho` emitting 1 from its inside.
+fn mirror_enclosure(rho: f64) -> String {
+    format!(
+        r#"(
+            camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
+            render: (width: 8, height: 8, max_bounces: 40),
+            materials: {{ "m": Mirror(reflectance: Constant({rho})) }},
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m", emission: Constant(1), two_sided: true) ],
+        )"#
+    )
+}
+
+/// The camera at the centre of a glass sphere (n 1.5) in the uniform enclosure.
+fn camera_in_glass() -> String {
+    format!(
+        r#"(
+        camera: (eye: (0, 0, 0), look_at: (0.3, 0.2, -1), fov_deg: 60),
+        render: (width: 8, height: 8, max_bounces: 64),
+        materials: {{ "glass": Dielectric(ior: Constant(1.5)) }},
+        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"), {ENCLOSURE} ],
+    )"#
+    )
+}
+
+/// The camera 1e-3 above a Lambertian plane (ρ 0.5) under a uniform sky of radius 1000, a 2° view.
+fn grazing_plane() -> String {
+    format!(
+        r#"(
+        camera: (eye: (0, 0.001, 0), look_at: (0, 0.001, -1), fov_deg: 2),
+        render: (width: 8, height: 8, max_bounces: 8),
+        materials: {{ "m": Lambertian(reflectance: Constant(0.5)) }},
+        objects: [ (shape: Plane(point: (0, 0, 0), normal: (0, 1, 0)), material: "m"), {} ],
+    )"#,
+        ENCLOSURE.replace("radius: 10", "radius: 1000")
+    )
+}
+
 /// A uniformly emitting enclosure (radiance 1, equal energy: Y = 1).
 const ENCLOSURE: &str = "(shape: Sphere(center: (0, 0, 0), radius: 10), emission: Constant(1), two_sided: true)";
 
@@ -78,13 +124,7 @@ const ENCLOSURE: &str = "(shape: Sphere(center: (0, 0, 0), radius: 10), emission
 /// (from the pixel spread) plus 0.3% for the CMF normalisation and f32.
 #[test]
 fn lambertian_sphere_with_a_point_light_at_its_centre() {
-    let scene = r#"(
-        camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
-        render: (width: 12, height: 12, max_bounces: 10000),
-        materials: { "m": Lambertian(reflectance: Constant(0.5)) },
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m") ],
-        lights: [ Point(position: (0, 0, 0), intensity: Constant(1)) ],
-    )"#;
+    let scene = POINT_IN_SPHERE;
     let pi = std::f64::consts::PI;
     for m in METHODS {
         let film = render_str(scene, &method(m, 32, 1));
@@ -111,14 +151,7 @@ fn lambertian_sphere_with_a_point_light_at_its_centre() {
 #[test]
 fn emitting_mirror_enclosure_is_le_over_one_minus_rho() {
     for rho in [0.5f64, 0.8] {
-        let scene = format!(
-            r#"(
-            camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
-            render: (width: 8, height: 8, max_bounces: 40),
-            materials: {{ "m": Mirror(reflectance: Constant({rho})) }},
-            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m", emission: Constant(1), two_sided: true) ],
-        )"#
-        );
+        let scene = mirror_enclosure(rho);
         for m in METHODS {
             let film = render_str(&scene, &method(m, 32, 2));
             if m == "lighttrace" {

@@ -89,15 +89,7 @@ fn grazing_incidence_on_glass_follows_fresnel() {
 /// down to 1e-4. Image mean of those pixels within 5 s.e. + 0.5%.
 #[test]
 fn grazing_view_of_a_diffuse_plane() {
-    let scene = format!(
-        r#"(
-        camera: (eye: (0, 0.001, 0), look_at: (0, 0.001, -1), fov_deg: 2),
-        render: (width: 8, height: 8, max_bounces: 8),
-        materials: {{ "m": Lambertian(reflectance: Constant(0.5)) }},
-        objects: [ (shape: Plane(point: (0, 0, 0), normal: (0, 1, 0)), material: "m"), {} ],
-    )"#,
-        ENCLOSURE.replace("radius: 10", "radius: 1000")
-    );
+    let scene = grazing_plane();
     for m in METHODS {
         let v = y(&render_str(&scene, &method(m, 32, 16)));
         if m == "lighttrace" {
