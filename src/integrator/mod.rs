@@ -194,10 +194,6 @@ pub fn describe(scene: &Scene) -> String {
         IntegratorKind::Auto => "auto: no dispersive material: full-spectrum path tracing (all 36 bins on every path, no wavelength sampling)".into(),
         IntegratorKind::Path if dispersive => "path: full spectrum; dispersive glass refracts every wavelength like 589.3 nm (no rainbow)".into(),
         IntegratorKind::Path => "path: full-spectrum path tracing".into(),
-        IntegratorKind::Bdpt | IntegratorKind::LightTrace if scene.has_nested_media() => format!(
-            "{}: WARNING: dielectrics nest or overlap here, and {0} has no medium stack: every dielectric surface is treated as if vacuum were outside (use auto or path)",
-            s.integrator.name()
-        ),
         IntegratorKind::Bdpt => "bdpt: bidirectional path tracing, every strategy combined by MIS (power heuristic)".into(),
         IntegratorKind::LightTrace => "lighttrace: light subpaths connected to the camera only (no camera paths)".into(),
         IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
@@ -215,6 +211,19 @@ pub fn describe(scene: &Scene) -> String {
             w => format!("spectral, {w:?} packets of {} wavelengths, split at dispersive surfaces", s.packet_size).to_lowercase(),
         },
     }
+}
+
+/// A warning about the chosen method on this scene, if it has one to give:
+/// `bdpt` and `lighttrace` have no medium stack, so where dielectrics nest
+/// or overlap they treat every dielectric surface as if vacuum were outside.
+pub fn warning(scene: &Scene) -> Option<String> {
+    let s = &scene.settings;
+    (matches!(s.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace) && scene.has_nested_media()).then(|| {
+        format!(
+            "dielectrics nest or overlap in this scene, and {} has no medium stack: every dielectric surface is treated as if vacuum were outside (use auto or path)",
+            s.integrator.name()
+        )
+    })
 }
 
 /// A function generic over the estimator type (a closure cannot be generic).
