@@ -378,28 +378,12 @@ impl Film {
     pub(crate) fn add_splats<S: FilmSample>(&mut self, splats: &[Splat<S>]) -> usize {
         let mut bad = 0;
         for s in splats {
-            let v = s.value.xyz();
-            let bins = s.value.bins();
-            if !(v.x.is_finite() && v.y.is_finite() && v.z.is_finite()) || bins.is_some_and(|b| b.has_nan_or_inf()) {
-                bad += 1;
-                continue;
-            }
             if s.x >= self.width || s.y >= self.height {
                 continue;
             }
             let k = s.y as usize * self.width as usize + s.x as usize;
-            if v.x.abs().max(v.y.abs()).max(v.z.abs()) > MAX_SAMPLE {
-                bad += 1;
-            }
-            if let (Some(spec), Some(b)) = (self.spectral.as_mut(), bins) {
-                for (acc, &x) in spec[k].iter_mut().zip(&b.0) {
-                    *acc += to_fixed(x);
-                }
-            }
-            let sum = &mut self.sums[k];
-            sum[0] += to_fixed(v.x);
-            sum[1] += to_fixed(v.y);
-            sum[2] += to_fixed(v.z);
+            let spec = self.spectral.as_mut().map(|spec| &mut spec[k]);
+            bad += add_sample(&mut self.sums[k], spec, &s.value);
         }
         bad
     }
@@ -490,30 +474,33 @@ fn add_tile_to_rows<S: FilmSample>(
     for y in tile.y0..tile.y1 {
         let row = (y - first_row) as usize * width as usize;
         for x in tile.x0..tile.x1 {
-            let sample = samples[k];
-            let s = sample.xyz();
+            let i = row + x as usize;
+            bad += add_sample(&mut rows[i], spectral.as_deref_mut().map(|spec| &mut spec[i]), &samples[k]);
             k += 1;
-            let bins = sample.bins();
-            if !(s.x.is_finite() && s.y.is_finite() && s.z.is_finite()) || bins.is_some_and(|b| b.has_nan_or_inf()) {
-                bad += 1;
-                continue;
-            }
-            if let (Some(spec), Some(b)) = (spectral.as_deref_mut(), bins) {
-                let sum = &mut spec[row + x as usize];
-                for (acc, &v) in sum.iter_mut().zip(&b.0) {
-                    *acc += to_fixed(v);
-                }
-            }
-            if s.x.abs().max(s.y.abs()).max(s.z.abs()) > MAX_SAMPLE {
-                bad += 1;
-            }
-            let sum = &mut rows[row + x as usize];
-            sum[0] += to_fixed(s.x);
-            sum[1] += to_fixed(s.y);
-            sum[2] += to_fixed(s.z);
         }
     }
     bad
+}
+
+/// Adds one sample to a pixel's sums (and its spectral sums, if the film has
+/// them). A non-finite sample is dropped, one beyond ±[`MAX_SAMPLE`] clamped;
+/// returns 1 for either (the renderer reports them), else 0.
+#[inline]
+fn add_sample<S: FilmSample>(sum: &mut [i128; 3], spectral: Option<&mut [i128; N_BINS]>, sample: &S) -> usize {
+    let s = sample.xyz();
+    let bins = sample.bins();
+    if !(s.x.is_finite() && s.y.is_finite() && s.z.is_finite()) || bins.is_some_and(|b| b.has_nan_or_inf()) {
+        return 1;
+    }
+    if let (Some(spec), Some(b)) = (spectral, bins) {
+        for (acc, &v) in spec.iter_mut().zip(&b.0) {
+            *acc += to_fixed(v);
+        }
+    }
+    sum[0] += to_fixed(s.x);
+    sum[1] += to_fixed(s.y);
+    sum[2] += to_fixed(s.z);
+    usize::from(s.x.abs().max(s.y.abs()).max(s.z.abs()) > MAX_SAMPLE)
 }
 
 #[cfg(test)]

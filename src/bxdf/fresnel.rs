@@ -108,35 +108,10 @@ mod tests {
         assert!((fresnel_dielectric(0.0, eta) - 1.0).abs() < 1e-6);
     }
 
-    /// A minimal complex number, for an implementation of the Fresnel
-    /// equations independent of `fresnel_conductor`'s real closed form.
-    #[derive(Clone, Copy)]
-    struct C(f64, f64);
-    impl C {
-        fn add(self, o: C) -> C {
-            C(self.0 + o.0, self.1 + o.1)
-        }
-        fn sub(self, o: C) -> C {
-            C(self.0 - o.0, self.1 - o.1)
-        }
-        fn mul(self, o: C) -> C {
-            C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
-        }
-        fn div(self, o: C) -> C {
-            let d = o.0 * o.0 + o.1 * o.1;
-            C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
-        }
-        fn norm2(self) -> f64 {
-            self.0 * self.0 + self.1 * self.1
-        }
-        /// The principal square root.
-        fn sqrt(self) -> C {
-            let r = self.norm2().sqrt();
-            let re = ((r + self.0) / 2.0).max(0.0).sqrt();
-            let im = ((r - self.0) / 2.0).max(0.0).sqrt();
-            C(re, if self.1 < 0.0 { -im } else { im })
-        }
-    }
+    // The complex Fresnel equations below are independent of
+    // `fresnel_conductor`'s real closed form; their complex arithmetic is the
+    // thin film's.
+    use crate::bxdf::thin_film::C;
 
     /// The textbook amplitude coefficients with complex numbers:
     /// cos θt = √(1 − sin²θ / η̃²), r_s = (cos θ − η̃ cos θt) / (cos θ + η̃ cos θt),

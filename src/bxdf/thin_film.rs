@@ -27,35 +27,36 @@ use super::{BsdfSample, Ior};
 use crate::color::{Sampled, Spectrum, bin_lambda_nm};
 use crate::spectral::Lambdas;
 
-/// A minimal complex number (f64) for the Airy sums.
+/// A minimal complex number (f64) for the Airy sums (and the complex
+/// Fresnel equations of `fresnel.rs`'s test).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct C(f64, f64);
+pub(super) struct C(pub(super) f64, pub(super) f64);
 
 impl C {
-    fn add(self, o: C) -> C {
+    pub(super) fn add(self, o: C) -> C {
         C(self.0 + o.0, self.1 + o.1)
     }
-    fn sub(self, o: C) -> C {
+    pub(super) fn sub(self, o: C) -> C {
         C(self.0 - o.0, self.1 - o.1)
     }
-    fn mul(self, o: C) -> C {
+    pub(super) fn mul(self, o: C) -> C {
         C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
     }
-    fn div(self, o: C) -> C {
+    pub(super) fn div(self, o: C) -> C {
         let d = o.0 * o.0 + o.1 * o.1;
         if d == 0.0 {
             return C(0.0, 0.0);
         }
         C((self.0 * o.0 + self.1 * o.1) / d, (self.1 * o.0 - self.0 * o.1) / d)
     }
-    fn norm2(self) -> f64 {
+    pub(super) fn norm2(self) -> f64 {
         self.0 * self.0 + self.1 * self.1
     }
     fn conj(self) -> C {
         C(self.0, -self.1)
     }
     /// The principal square root (non-negative real part).
-    fn sqrt(self) -> C {
+    pub(super) fn sqrt(self) -> C {
         let r = self.norm2().sqrt();
         let re = ((r + self.0) / 2.0).max(0.0).sqrt();
         let im = ((r - self.0) / 2.0).max(0.0).sqrt();

@@ -531,12 +531,13 @@ impl Bdpt {
     }
 }
 
-/// True when a contribution is zero (or not a number: dropped like zero).
+/// True when a contribution is zero. (A NaN is not: it reaches the film,
+/// which drops and counts it, so a bug cannot hide here.)
 #[inline]
 fn is_black(c: &Contrib) -> bool {
     match c {
-        Contrib::Full(s) => s.is_black() || s.has_nan_or_inf(),
-        Contrib::Single(v) => !(v.abs() > 0.0 && v.is_finite()),
+        Contrib::Full(s) => s.is_black(),
+        Contrib::Single(v) => *v == 0.0,
     }
 }
 
@@ -649,7 +650,7 @@ impl Walk {
             let (here, before) = (path[n - 1], path[n - 2]);
             path[n - 2].pdf_rev = to_area(scene, rev, &here, &before);
             pdf_dir = fwd;
-            if beta.is_black() || beta.has_nan_or_inf() {
+            if beta.is_black() {
                 break;
             }
             bounces += 1;
