@@ -69,9 +69,6 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         ));
         say(format_args!("{}", rust_v::integrator::describe(&scene)));
     }
-    if let Some(w) = rust_v::integrator::warning(&scene) {
-        warn(format_args!("{w}"));
-    }
     // With a time budget and no --spp (or --passes), render until the time is up.
     let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });

@@ -68,18 +68,30 @@
 //! draw (as `auto`'s) could not be shared between two independent subpaths;
 //! the fixed draw costs colour noise only where dispersion is.
 //!
-//! # Limits (documented, not silent)
-//! - A shadow ray or connection inside an absorbing dielectric is
-//!   attenuated when one of its end vertices lies on that dielectric; a
-//!   connection between two points inside it that are on other objects is not.
-//! - Every surface assumes vacuum on its outside (no medium stack).
+//! # Nested dielectrics
+//! Both walks carry a [`MediumStack`], as the path tracer's do: the camera
+//! subpath starts in [`Scene::camera_media`], a light subpath in the media
+//! around its origin ([`Scene::media_at`], probed per subpath, only in scenes
+//! with a dielectric). A false intersection is no vertex: the walk goes
+//! straight on, and the next vertex's densities are those of the whole
+//! straight line. Each vertex remembers the medium outside its dielectric
+//! (for `eval`/`pdf`/`sample` with the right relative index) and, in scenes
+//! with dielectrics, the stack it was reached in. A connection leaves each
+//! end in the media on its side of the surface, passes false intersections
+//! (a march, only where media nest; elsewhere one occlusion test), and is
+//! attenuated by the one medium it runs in (the current medium does not
+//! change at a false intersection).
+//!
+//! Russian roulette ([`RR_DEPTH`]) continues with probability
+//! `min(1, β η_scale / β_0)`: a subpath that has lost nothing (a delta chain
+//! through clear glass) is never cut, so exact cases stay exact.
 
 use std::cell::RefCell;
 use std::sync::LazyLock;
 
 use glam::{Vec2, Vec3};
 
-use crate::bxdf::Bxdf;
+use crate::bxdf::{Bxdf, Crossing, MediumStack, Outside};
 use crate::color::{N_BINS, Sampled, Spectrum};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
@@ -88,7 +100,7 @@ use crate::sampler::Sampler;
 use crate::scene::Scene;
 use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, continuous_wavelength};
 
-use super::{Estimator, Shading};
+use super::{Estimator, MAX_PASSES, Shading, absorption};
 
 /// Russian roulette starts after this many scattering events on either
 /// subpath (the path tracer waits for 5, as Mitsuba does). A subpath vertex
@@ -141,13 +153,16 @@ struct Vertex {
     /// previous vertex (no cosine at the eye or a point light; 0 at a
     /// subpath's first vertex). Kept so connections need not recompute it.
     g_prev: f32,
+    /// At a dielectric's surface, the material of the medium on its outside
+    /// (`None`: vacuum, or not a dielectric).
+    outside: Option<u32>,
 }
 
 impl Vertex {
     fn at_point(kind: Kind, p: Vec3, n: Vec3, beta: Spectrum, pdf_fwd: f32) -> Vertex {
         let frame = Frame::from_z(if n == Vec3::ZERO { Vec3::Z } else { n });
         let sh = Shading { p, n, frame, wo: Vec3::Z, wo_n: 0.0 };
-        Vertex { kind, sh, beta, delta: false, collapsed: false, pdf_fwd, pdf_rev: 0.0, g_prev: 0.0 }
+        Vertex { kind, sh, beta, delta: false, collapsed: false, pdf_fwd, pdf_rev: 0.0, g_prev: 0.0, outside: None }
     }
 
     #[inline]
@@ -230,9 +245,44 @@ fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 {
     if c.is_finite() { c } else { 0.0 }
 }
 
+/// The two subpaths of a sample and, in scenes with dielectrics, the medium
+/// stack each vertex was reached in (index for index; empty otherwise).
+#[derive(Default)]
+struct Paths {
+    camera: Vec<Vertex>,
+    light: Vec<Vertex>,
+    camera_media: Vec<MediumStack>,
+    light_media: Vec<MediumStack>,
+}
+
+/// One subpath and its vertices' medium stacks.
+#[derive(Clone, Copy)]
+struct Sub<'p> {
+    v: &'p [Vertex],
+    media: &'p [MediumStack],
+}
+
+impl Sub<'_> {
+    /// The media around vertex `i` on the side of world direction `w` (None
+    /// in a scene without dielectrics).
+    #[inline]
+    fn media_towards(&self, scene: &Scene, i: usize, w: Vec3) -> Option<MediumStack> {
+        let mut media = *self.media.get(i)?;
+        let v = &self.v[i];
+        if let Kind::Surface(o) = v.kind
+            && let Some(m) = scene.medium(o)
+            && w.dot(v.sh.n) * v.sh.wo_n < 0.0
+        {
+            // Across the surface from where the subpath arrived.
+            media.cross(m, v.sh.wo_n > 0.0);
+        }
+        Some(media)
+    }
+}
+
 thread_local! {
-    /// The two subpaths of the current sample, reused (no allocation per sample).
-    static PATHS: RefCell<(Vec<Vertex>, Vec<Vertex>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+    /// The subpaths of the current sample, reused (no allocation per sample).
+    static PATHS: RefCell<Paths> = RefCell::new(Paths::default());
 }
 
 impl Estimator for Bdpt {
@@ -245,20 +295,24 @@ impl Estimator for Bdpt {
     ) -> O {
         PATHS.with(|paths| {
             let mut paths = paths.borrow_mut();
-            let (camera, light) = &mut *paths;
+            let Paths { camera, light, camera_media, light_media } = &mut *paths;
             camera.clear();
             light.clear();
+            camera_media.clear();
+            light_media.clear();
+            let track = scene.has_media();
             let mut wl = Wavelength { u: sampler.next_1d(), continuous: O::CONTINUOUS, drawn: None };
             let full = Lambdas::full();
             let (mut l, mut l_single) = (Spectrum::ZERO, 0.0f32);
             if !self.light_only {
-                self.camera_subpath(scene, film, sampler, camera, &mut wl);
+                self.camera_subpath(scene, film, sampler, camera, track.then_some(&mut *camera_media), &mut wl);
             }
-            self.light_subpath(scene, sampler, light, &mut wl);
+            self.light_subpath(scene, sampler, light, track.then_some(&mut *light_media), &mut wl);
             let max = self.max_bounces as usize;
-            let t_range = if self.light_only { 1..=1 } else { 1..=camera.len() };
+            let (camera, light) = (Sub { v: camera, media: camera_media }, Sub { v: light, media: light_media });
+            let t_range = if self.light_only { 1..=1 } else { 1..=camera.v.len() };
             for t in t_range {
-                for s in 0..=light.len() {
+                for s in 0..=light.v.len() {
                     if s + t < 2 || s + t - 2 > max || (t == 1 && s == 0) {
                         continue;
                     }
@@ -295,18 +349,29 @@ impl Bdpt {
         film: Vec2,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
+        mut stacks: Option<&mut Vec<MediumStack>>,
         wl: &mut Wavelength,
     ) {
         let cam = &scene.camera;
         let ray = cam.ray(film);
         path.push(Vertex::at_point(Kind::Camera, ray.origin, cam.forward(), Spectrum::ONE, 1.0));
+        if let Some(stacks) = stacks.as_deref_mut() {
+            stacks.push(scene.camera_media);
+        }
         let pdf_dir = cam.pdf_dir(ray.dir);
         let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2 };
-        walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, wl);
+        walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_media, wl);
     }
 
     /// A light by power, a ray leaving it, and its walk.
-    fn light_subpath(&self, scene: &Scene, sampler: &mut Sampler, path: &mut Vec<Vertex>, wl: &mut Wavelength) {
+    fn light_subpath(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        path: &mut Vec<Vertex>,
+        mut stacks: Option<&mut Vec<MediumStack>>,
+        wl: &mut Wavelength,
+    ) {
         let u_light = sampler.next_1d();
         let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
         let Some((index, pmf)) = scene.choose_light(u_light) else {
@@ -322,6 +387,10 @@ impl Bdpt {
         }
         let beta0 = *light.spectrum() / pdf_origin;
         path.push(Vertex::at_point(Kind::Light(index as u32), e.point, e.n, beta0, pdf_origin));
+        let media = scene.media_at(e.point);
+        if let Some(stacks) = stacks.as_deref_mut() {
+            stacks.push(media);
+        }
         let cos = if light.is_delta() { 1.0 } else { e.dir.dot(e.n).abs() };
         let beta = beta0 * (e.scale * cos / e.pdf_dir);
         // A parallel light's next vertex has the density of the ray's origin
@@ -329,7 +398,7 @@ impl Bdpt {
         let (pdf, parallel) = if light.is_delta_direction() { (e.pdf_pos, true) } else { (e.pdf_dir, false) };
         let ray = Ray::spawn(e.point, e.n, e.dir);
         let walk = Walk { importance: true, max_vertices: self.max_bounces as usize + 1 };
-        walk.run(scene, ray, beta, pdf, parallel, sampler, path, wl);
+        walk.run(scene, ray, beta, pdf, parallel, sampler, path, stacks, media, wl);
     }
 
     /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye. Returns
@@ -337,12 +406,12 @@ impl Bdpt {
     fn connect_camera(
         &self,
         scene: &Scene,
-        light: &[Vertex],
+        light: Sub<'_>,
         s: usize,
-        camera: &[Vertex],
+        camera: Sub<'_>,
         wl: &mut Wavelength,
     ) -> Option<(Vec2, Contrib)> {
-        let qs = &light[s - 1];
+        let qs = &light.v[s - 1];
         if !connectible(scene, qs) {
             return None;
         }
@@ -380,12 +449,13 @@ impl Bdpt {
                     return None;
                 }
                 let k = wi.z.abs() * shading_correction(&qs.sh, w, wi) * importance;
+                let out = outside(scene, qs.outside);
                 if single {
                     let one = wl.single();
-                    let f = bxdf.eval(wi, qs.sh.wo, &one.lambdas)[0];
+                    let f = bxdf.eval_within(wi, qs.sh.wo, &one.lambdas, out)[0];
                     Contrib::Single(wl.at(&qs.beta, qs.collapsed) * f * k)
                 } else {
-                    Contrib::Full(qs.beta * bxdf.eval(wi, qs.sh.wo, &Lambdas::full()) * k)
+                    Contrib::Full(qs.beta * bxdf.eval_within(wi, qs.sh.wo, &Lambdas::full(), out) * k)
                 }
             }
             Kind::Camera => return None,
@@ -393,22 +463,19 @@ impl Bdpt {
         if is_black(&c) {
             return None;
         }
-        let (shadow, t_max) = Ray::spawn_to(qs.p(), qs.sh.n, eye);
-        if scene.occluded(&shadow, t_max) {
-            return None;
-        }
+        let transmittance = segment(scene, qs, light.media_towards(scene, s - 1, w).as_ref(), eye)?;
         let weight = if self.light_only {
             1.0
         } else {
-            let eye_v = &camera[0];
+            let eye_v = &camera.v[0];
             let qs_rev = to_area(scene, cam.pdf_dir(-w), eye_v, qs);
             let qsm_rev = match qs.kind {
-                Kind::Surface(o) if s >= 2 => pdf_local(scene, o, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev,
+                Kind::Surface(_) if s >= 2 => pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev,
                 _ => 0.0,
             };
-            mis_weight(scene, camera, 1, light, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
+            mis_weight(scene, camera.v, 1, light.v, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
         };
-        Some((film, scale(c, weight, attenuation(scene, qs, eye), wl)))
+        Some((film, scale(c, weight, transmittance, wl)))
     }
 
     /// Strategies `(s, t ≥ 2)`: emitter hit (`s = 0`), next-event estimation
@@ -417,19 +484,19 @@ impl Bdpt {
     fn connect(
         &self,
         scene: &Scene,
-        camera: &[Vertex],
+        camera: Sub<'_>,
         t: usize,
-        light: &[Vertex],
+        light: Sub<'_>,
         s: usize,
         sampler: &mut Sampler,
         wl: &mut Wavelength,
     ) -> Contrib {
         const NONE: Contrib = Contrib::Full(Spectrum::ZERO);
-        let pt = &camera[t - 1];
+        let pt = &camera.v[t - 1];
         let Kind::Surface(object) = pt.kind else {
             return NONE;
         };
-        let ptm = &camera[t - 2];
+        let ptm = &camera.v[t - 2];
         match s {
             0 => {
                 // The camera subpath ends on an emitter.
@@ -453,7 +520,7 @@ impl Bdpt {
                 let as_light = Vertex { kind: Kind::Light(index), ..*pt };
                 let ptm_rev = to_area(scene, pdf_dir, &as_light, ptm);
                 let overrides = Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 };
-                scale(c, mis_weight(scene, camera, t, &[], 0, overrides), None, wl)
+                scale(c, mis_weight(scene, camera.v, t, &[], 0, overrides), None, wl)
             }
             1 => {
                 // Next-event estimation: a fresh point on a light.
@@ -473,33 +540,36 @@ impl Bdpt {
                     return NONE;
                 }
                 let bxdf = material(scene, object);
+                let out = outside(scene, pt.outside);
                 let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
-                let c = if pt.collapsed || bxdf.is_dispersive() {
+                let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
-                    let f = bxdf.eval(pt.sh.wo, wi, &one.lambdas)[0];
+                    let f = bxdf.eval_within(pt.sh.wo, wi, &one.lambdas, out)[0];
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(light.spectrum())[0] * k)
                 } else {
-                    Contrib::Full(pt.beta * bxdf.eval(pt.sh.wo, wi, &Lambdas::full()) * *light.spectrum() * k)
+                    Contrib::Full(
+                        pt.beta * bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out) * *light.spectrum() * k,
+                    )
                 };
                 if is_black(&c) {
                     return NONE;
                 }
-                let (shadow, t_max) = Ray::spawn_to(pt.p(), pt.sh.n, ls.point);
-                if scene.occluded(&shadow, t_max) {
+                let media = camera.media_towards(scene, t - 1, ls.wi);
+                let Some(transmittance) = segment(scene, pt, media.as_ref(), ls.point) else {
                     return NONE;
-                }
+                };
                 // The sampled light vertex, for the MIS weight.
                 let (pdf_pos, _) = light.pdf_le(ls.n, -ls.wi);
                 let y = Vertex::at_point(Kind::Light(index as u32), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
                 let pt_rev = pdf_light(scene, &y, pt);
-                let ptm_rev = bxdf.pdf(wi, pt.sh.wo, &Lambdas::full()) * pt.g_prev;
-                let qs_rev = to_area(scene, bxdf.pdf(pt.sh.wo, wi, &Lambdas::full()), pt, &y);
+                let ptm_rev = bxdf.pdf_within(wi, pt.sh.wo, &Lambdas::full(), out) * pt.g_prev;
+                let qs_rev = to_area(scene, bxdf.pdf_within(pt.sh.wo, wi, &Lambdas::full(), out), pt, &y);
                 let overrides = Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 };
-                let weight = mis_weight(scene, camera, t, std::slice::from_ref(&y), 1, overrides);
-                scale(c, weight, attenuation(scene, pt, ls.point), wl)
+                let weight = mis_weight(scene, camera.v, t, std::slice::from_ref(&y), 1, overrides);
+                scale(c, weight, transmittance, wl)
             }
             _ => {
-                let qs = &light[s - 1];
+                let qs = &light.v[s - 1];
                 if !connectible(scene, pt) || !connectible(scene, qs) {
                     return NONE;
                 }
@@ -517,34 +587,35 @@ impl Bdpt {
                     return NONE;
                 }
                 let (bp, bq) = (material(scene, object), material(scene, q_object));
+                let (op, oq) = (outside(scene, pt.outside), outside(scene, qs.outside));
                 let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
-                let c = if pt.collapsed || qs.collapsed || bp.is_dispersive() || bq.is_dispersive() {
+                let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {
                     let one = wl.single();
-                    let fp = bp.eval(pt.sh.wo, wi_p, &one.lambdas)[0];
-                    let fq = bq.eval(wi_q, qs.sh.wo, &one.lambdas)[0];
+                    let fp = bp.eval_within(pt.sh.wo, wi_p, &one.lambdas, op)[0];
+                    let fq = bq.eval_within(wi_q, qs.sh.wo, &one.lambdas, oq)[0];
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
                 } else {
                     let full = Lambdas::full();
-                    Contrib::Full(
-                        pt.beta * bp.eval(pt.sh.wo, wi_p, &full) * bq.eval(wi_q, qs.sh.wo, &full) * qs.beta * k,
-                    )
+                    let (fp, fq) =
+                        (bp.eval_within(pt.sh.wo, wi_p, &full, op), bq.eval_within(wi_q, qs.sh.wo, &full, oq));
+                    Contrib::Full(pt.beta * fp * fq * qs.beta * k)
                 };
                 if is_black(&c) {
                     return NONE;
                 }
-                let (shadow, t_max) = Ray::spawn_to(pt.p(), pt.sh.n, qs.p());
-                if scene.occluded(&shadow, t_max) {
+                let media = camera.media_towards(scene, t - 1, w);
+                let Some(transmittance) = segment(scene, pt, media.as_ref(), qs.p()) else {
                     return NONE;
-                }
+                };
                 // The four densities the connection changes, from the local
                 // directions already at hand (`wo` points back along each subpath).
                 let full = Lambdas::full();
-                let pt_rev = bq.pdf(qs.sh.wo, wi_q, &full) * w.dot(pt.sh.n).abs() / d2;
-                let qs_rev = bp.pdf(pt.sh.wo, wi_p, &full) * w.dot(qs.sh.n).abs() / d2;
-                let ptm_rev = bp.pdf(wi_p, pt.sh.wo, &full) * pt.g_prev;
-                let qsm_rev = bq.pdf(wi_q, qs.sh.wo, &full) * qs.g_prev;
-                let weight = mis_weight(scene, camera, t, light, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
-                scale(c, weight, attenuation(scene, pt, qs.p()), wl)
+                let pt_rev = bq.pdf_within(qs.sh.wo, wi_q, &full, oq) * w.dot(pt.sh.n).abs() / d2;
+                let qs_rev = bp.pdf_within(pt.sh.wo, wi_p, &full, op) * w.dot(qs.sh.n).abs() / d2;
+                let ptm_rev = bp.pdf_within(wi_p, pt.sh.wo, &full, op) * pt.g_prev;
+                let qsm_rev = bq.pdf_within(wi_q, qs.sh.wo, &full, oq) * qs.g_prev;
+                let weight = mis_weight(scene, camera.v, t, light.v, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
+                scale(c, weight, transmittance, wl)
             }
         }
     }
@@ -594,10 +665,13 @@ impl Walk {
         mut parallel: bool,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
+        mut stacks: Option<&mut Vec<MediumStack>>,
+        mut media: MediumStack,
         wl: &mut Wavelength,
     ) {
         let full = Lambdas::full();
         let beta_ref = beta.max_value();
+        let mut passes = 0;
         let mut collapsed = false;
         let mut bounces = 0u32;
         // Radiance transport divides by η² at each refraction; roulette looks
@@ -609,10 +683,8 @@ impl Walk {
             };
             let hit = si.hit;
             let bxdf = material(scene, si.object);
-            // Beer-Lambert along a segment inside an absorbing dielectric.
-            if let Some(sigma) = bxdf.absorption()
-                && ray.dir.dot(hit.n) > 0.0
-            {
+            // Beer-Lambert along the segment, in the medium it ran in.
+            if let Some(sigma) = absorption(scene, media.current()) {
                 if collapsed {
                     let one = wl.single();
                     beta[one.slot] *= (-one.lambdas.sample(sigma)[0] * hit.t).exp();
@@ -620,6 +692,31 @@ impl Walk {
                     beta *= (*sigma * -hit.t).exp();
                 }
             }
+            // Nested dielectrics: a false intersection is no vertex; the walk
+            // goes straight on (densities stay those of the whole straight line).
+            let arrival = media;
+            let mut crossing = None;
+            let mut outside_material = None;
+            if let Some(m) = scene.medium(si.object) {
+                let entering = ray.dir.dot(hit.n) < 0.0;
+                match media.crossing(m, entering) {
+                    Crossing::Pass => {
+                        media.cross(m, entering);
+                        passes += 1;
+                        if passes > MAX_PASSES {
+                            break;
+                        }
+                        ray = Ray::spawn(hit.p, hit.n, ray.dir);
+                        continue;
+                    }
+                    Crossing::Interface { outside } => {
+                        crossing = Some((m, entering));
+                        outside_material = outside;
+                    }
+                }
+            }
+            passes = 0;
+            let out = outside(scene, outside_material);
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             let prev = *path.last().expect("a subpath starts at the eye or a light");
             let mut v = Vertex {
@@ -631,16 +728,20 @@ impl Walk {
                 pdf_fwd: 0.0,
                 pdf_rev: 0.0,
                 g_prev: 0.0,
+                outside: outside_material,
             };
             v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, &prev, &v) };
             v.g_prev = to_area(scene, 1.0, &v, &prev);
             parallel = false;
             path.push(v);
+            if let Some(stacks) = stacks.as_deref_mut() {
+                stacks.push(arrival);
+            }
             if path.len() >= self.max_vertices || bxdf.is_black() {
                 break;
             }
             let (u, uc) = (sampler.next_2d(), sampler.next_1d());
-            let sample = if collapsed || bxdf.is_dispersive() {
+            let sample = if collapsed || bxdf.dispersion_within(out).is_some() {
                 let one = wl.single();
                 if !collapsed {
                     // The direction depends on the wavelength: the subpath collapses to the
@@ -650,13 +751,13 @@ impl Walk {
                     beta[one.slot] = v;
                     collapsed = true;
                 }
-                bxdf.sample(sh.wo, u, uc, &one.lambdas).map(|s| {
+                bxdf.sample_within(sh.wo, u, uc, &one.lambdas, out).map(|s| {
                     let mut f = Spectrum::ZERO;
                     f[one.slot] = s.f[0];
                     crate::bxdf::BsdfSample { wi: s.wi, f, pdf: s.pdf, is_delta: s.is_delta, eta: s.eta }
                 })
             } else {
-                bxdf.sample(sh.wo, u, uc, &full)
+                bxdf.sample_within(sh.wo, u, uc, &full, out)
             };
             let Some(bs) = sample else {
                 break;
@@ -673,7 +774,12 @@ impl Walk {
                 eta_scale *= bs.eta * bs.eta;
             }
             beta *= weight;
-            let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf(bs.wi, sh.wo, &full)) };
+            if let Some((m, entering)) = crossing
+                && wi.dot(hit.n) * ray.dir.dot(hit.n) > 0.0
+            {
+                media.cross(m, entering);
+            }
+            let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf_within(bs.wi, sh.wo, &full, out)) };
             let n = path.len();
             path[n - 1].delta = bs.is_delta;
             path[n - 2].pdf_rev = rev * path[n - 1].g_prev;
@@ -715,10 +821,11 @@ fn connectible(scene: &Scene, v: &Vertex) -> bool {
     }
 }
 
-/// True when vertex `v` lies on a dispersive surface.
+/// True when vertex `v` lies on a dispersive surface (its glass or the
+/// medium outside it disperses).
 #[inline]
 fn is_dispersive(scene: &Scene, v: &Vertex) -> bool {
-    matches!(v.kind, Kind::Surface(o) if material(scene, o).is_dispersive())
+    matches!(v.kind, Kind::Surface(o) if material(scene, o).dispersion_within(outside(scene, v.outside)).is_some())
 }
 
 /// The emitted quantity from light point (normal `n`) towards `w`, as a
@@ -733,19 +840,49 @@ fn emit_factor(light: &Light, n: Vec3, w: Vec3) -> f32 {
     }
 }
 
-/// Beer-Lambert attenuation of a connection from vertex `v` to point `to`
-/// that runs inside `v`'s absorbing dielectric.
+/// The medium outside a dielectric vertex, from its material index.
 #[inline]
-fn attenuation(scene: &Scene, v: &Vertex, to: Vec3) -> Option<Spectrum> {
-    if let Kind::Surface(o) = v.kind
-        && let Some(sigma) = material(scene, o).absorption()
-    {
-        let d = to - v.p();
-        if d.dot(v.sh.n) < 0.0 {
-            return Some((*sigma * -d.length()).exp());
+fn outside(scene: &Scene, material: Option<u32>) -> Outside<'_> {
+    match material.and_then(|m| scene.materials[m as usize].as_dielectric()) {
+        Some(d) => Outside::medium(d),
+        None => Outside::VACUUM,
+    }
+}
+
+/// The segment of a connection from vertex `v` to point `to`, starting in
+/// `media` (the media around `v` on the segment's side; `None` in a scene
+/// without dielectrics). `None` when something blocks it; else the
+/// segment's transmittance when it runs in an absorbing medium.
+///
+/// Among nested dielectrics a segment passes false intersections (surfaces
+/// the medium stack says are not interfaces here, at most [`MAX_PASSES`]);
+/// the medium it runs in does not change at them, so one Beer-Lambert factor
+/// of the current medium over the whole length is exact.
+fn segment(scene: &Scene, v: &Vertex, media: Option<&MediumStack>, to: Vec3) -> Option<Option<Spectrum>> {
+    let (mut ray, mut t_max) = Ray::spawn_to(v.p(), v.sh.n, to);
+    match media {
+        Some(stack) if scene.has_nested_media() => {
+            let mut stack = *stack;
+            let mut passes = 0;
+            while let Some(si) = scene.intersect(&ray, t_max) {
+                let entering = ray.dir.dot(si.hit.n) < 0.0;
+                match scene.medium(si.object) {
+                    Some(m) if passes < MAX_PASSES && stack.crossing(m, entering) == Crossing::Pass => {
+                        stack.cross(m, entering);
+                        passes += 1;
+                        (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to);
+                    }
+                    _ => return None,
+                }
+            }
+        }
+        _ => {
+            if scene.occluded(&ray, t_max) {
+                return None;
+            }
         }
     }
-    None
+    Some(absorption(scene, media.and_then(|m| m.current())).map(|sigma| (*sigma * -(to - v.p()).length()).exp()))
 }
 
 /// Converts a density per solid angle at `from` towards `to` into a density
@@ -764,11 +901,14 @@ fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -> f32 {
     pdf
 }
 
-/// The BSDF density of object `o`'s material for local directions `wo`, `wi`
+/// The BSDF density at surface vertex `v` for local directions `wo`, `wi`
 /// (0 for delta lobes).
 #[inline]
-fn pdf_local(scene: &Scene, o: u32, wo: Vec3, wi: Vec3) -> f32 {
-    material(scene, o).pdf(wo, wi, &Lambdas::full())
+fn pdf_at(scene: &Scene, v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
+    match v.kind {
+        Kind::Surface(o) => material(scene, o).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside)),
+        _ => 0.0,
+    }
 }
 
 /// The area density at `next` of the ray `sample_le` would start from light

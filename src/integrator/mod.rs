@@ -166,13 +166,8 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
 /// True when the scene has light that path tracing cannot reach well: a
 /// delta light (point, spot, distant, beam) together with a specular
 /// surface (smooth glass, mirror, smooth metal, thin sheet), whose caustics
-/// no camera path can connect to the light. `auto` then picks `bdpt`, unless
-/// dielectrics nest or overlap ([`Scene::has_nested_media`]): `bdpt` has no
-/// medium stack, so there `auto` keeps path tracing.
+/// no camera path can connect to the light. `auto` then picks `bdpt`.
 pub fn needs_bdpt(scene: &Scene) -> bool {
-    if scene.has_nested_media() {
-        return false;
-    }
     let delta_light = scene.lights.iter().any(|l| l.is_delta());
     delta_light && scene.objects.iter().any(|o| scene.materials[o.material as usize].is_delta())
 }
@@ -211,19 +206,6 @@ pub fn describe(scene: &Scene) -> String {
             w => format!("spectral, {w:?} packets of {} wavelengths, split at dispersive surfaces", s.packet_size).to_lowercase(),
         },
     }
-}
-
-/// A warning about the chosen method on this scene, if it has one to give:
-/// `bdpt` and `lighttrace` have no medium stack, so where dielectrics nest
-/// or overlap they treat every dielectric surface as if vacuum were outside.
-pub fn warning(scene: &Scene) -> Option<String> {
-    let s = &scene.settings;
-    (matches!(s.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace) && scene.has_nested_media()).then(|| {
-        format!(
-            "dielectrics nest or overlap in this scene, and {} has no medium stack: every dielectric surface is treated as if vacuum were outside (use auto or path)",
-            s.integrator.name()
-        )
-    })
 }
 
 /// A function generic over the estimator type (a closure cannot be generic).

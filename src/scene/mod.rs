@@ -13,7 +13,7 @@ mod spectra;
 
 pub use load::{load_scene, load_scene_str};
 
-use crate::bxdf::{Bxdf, Medium, MediumStack};
+use crate::bxdf::{Bxdf, MEDIUM_STACK_DEPTH, Medium, MediumStack};
 use crate::camera::Camera;
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::light::Light;
@@ -68,6 +68,10 @@ pub struct Scene {
     /// The dielectric media the camera's eye is inside, where every camera
     /// path starts ([`Scene::camera_media`]).
     pub camera_media: MediumStack,
+    /// Dielectric media nest or overlap ([`Scene::has_nested_media`]).
+    nested: bool,
+    /// Some object is a dielectric ([`Scene::has_media`]).
+    media: bool,
     /// Render settings: the file's `render` block with command-line overrides applied.
     pub settings: Settings,
     /// Indices of bounded objects, in the BVH's order when there is one.
@@ -116,6 +120,8 @@ impl Scene {
             l.set_scene_bounds(world.centroid(), radius);
         }
         let camera_media = media_at(camera.eye(), &objects, &materials);
+        let nested = nested_media(&camera_media, &objects, &materials);
+        let media = objects.iter().any(|o| materials[o.material as usize].as_dielectric().is_some());
         let bvh = (bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);
             bounded = bvh.prim_order().iter().map(|&k| bounded[k as usize]).collect();
@@ -146,6 +152,8 @@ impl Scene {
             light_cdf,
             camera,
             camera_media,
+            nested,
+            media,
             settings,
             bounded,
             unbounded,
@@ -222,23 +230,23 @@ impl Scene {
     /// True when dielectric media may nest or overlap, so that a path needs
     /// the medium stack: the camera starts inside a dielectric, or two
     /// dielectric objects' bounds overlap (an unbounded one overlaps all).
-    /// `bdpt` and `lighttrace` have no medium stack (`auto` avoids them here).
+    /// Only then do connections of `bdpt` and `lighttrace` march through
+    /// false intersections (elsewhere one occlusion test suffices).
+    #[inline]
     pub fn has_nested_media(&self) -> bool {
-        if !self.camera_media.is_empty() {
-            return true;
-        }
-        let glass: Vec<Option<Aabb>> = self
-            .objects
-            .iter()
-            .filter(|o| self.materials[o.material as usize].as_dielectric().is_some())
-            .map(|o| o.shape.bounds())
-            .collect();
-        glass.iter().enumerate().any(|(i, a)| {
-            glass[i + 1..].iter().any(|b| match (a, b) {
-                (Some(a), Some(b)) => a.min.cmple(b.max).all() && b.min.cmple(a.max).all(),
-                _ => true,
-            })
-        })
+        self.nested
+    }
+
+    /// True when some object is a dielectric (a medium a path can be inside).
+    #[inline]
+    pub fn has_media(&self) -> bool {
+        self.media
+    }
+
+    /// The dielectric media around point `p` (as [`Scene::camera_media`] is
+    /// for the eye): where a light subpath starts.
+    pub fn media_at(&self, p: glam::Vec3) -> MediumStack {
+        if self.media { media_at(p, &self.objects, &self.materials) } else { MediumStack::VACUUM }
     }
 
     /// True when any material's direction depends on wavelength.
@@ -272,8 +280,12 @@ const PROBES: [[f32; 3]; 6] = [
 /// edge. Among the objects found, the one whose surface is farthest is the
 /// outermost, entered first (so equal priorities nest by geometry: a camera
 /// in water inside glass is in the water).
+/// No allocation (BDPT asks at every light subpath's origin); beyond
+/// [`MEDIUM_STACK_DEPTH`] media the innermost are dropped, as a path's stack
+/// drops them.
 fn media_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> MediumStack {
-    let mut found: Vec<(f32, Medium)> = Vec::new();
+    let mut found = [(0.0f32, Medium::default()); MEDIUM_STACK_DEPTH];
+    let mut count = 0;
     for (i, o) in objects.iter().enumerate() {
         if materials[o.material as usize].as_dielectric().is_none() {
             continue;
@@ -291,15 +303,39 @@ fn media_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> MediumStac
             }
         }
         if leave > enter {
-            found.push((nearest, Medium { object: i as u32, priority: o.priority, material: o.material }));
+            let m = (nearest, Medium { object: i as u32, priority: o.priority, material: o.material });
+            // Keep the MEDIUM_STACK_DEPTH farthest surfaces, sorted farthest first.
+            let at = found[..count].partition_point(|f| f.0.total_cmp(&nearest).is_ge());
+            if at < MEDIUM_STACK_DEPTH {
+                found.copy_within(at..(count.min(MEDIUM_STACK_DEPTH - 1)), at + 1);
+                found[at] = m;
+                count = (count + 1).min(MEDIUM_STACK_DEPTH);
+            }
         }
     }
-    found.sort_by(|a, b| b.0.total_cmp(&a.0));
     let mut stack = MediumStack::VACUUM;
-    for (_, m) in found {
+    for &(_, m) in &found[..count] {
         stack.enter(m);
     }
     stack
+}
+
+/// Whether media nest ([`Scene::has_nested_media`]).
+fn nested_media(camera_media: &MediumStack, objects: &[Object], materials: &[Bxdf]) -> bool {
+    if !camera_media.is_empty() {
+        return true;
+    }
+    let glass: Vec<Option<Aabb>> = objects
+        .iter()
+        .filter(|o| materials[o.material as usize].as_dielectric().is_some())
+        .map(|o| o.shape.bounds())
+        .collect();
+    glass.iter().enumerate().any(|(i, a)| {
+        glass[i + 1..].iter().any(|b| match (a, b) {
+            (Some(a), Some(b)) => a.min.cmple(b.max).all() && b.min.cmple(a.max).all(),
+            _ => true,
+        })
+    })
 }
 
 #[cfg(test)]
