@@ -29,8 +29,10 @@
 //!    keeps the bin centres;
 //! 4. at a non-delta surface add direct light (one light sample, MIS);
 //! 5. sample the BSDF for the next direction and update `β ← β f |cos| / pdf`;
-//! 6. after 5 bounces continue with probability `q = min(max_λ β · η², 0.95)`
-//!    and divide `β` by `q` (unbiased).
+//! 6. after [`RR_DEPTH`] bounces continue with probability
+//!    `q = min(max_λ β · η², 1)` and divide `β` by `q` (unbiased; pbrt-v4's
+//!    rule: a path that has lost nothing, a chain through clear glass, is
+//!    never cut).
 
 use crate::bxdf::{BsdfSample, Dispersion, MediumStack};
 use crate::color::{N_BINS, Sampled, Spectrum};
@@ -44,8 +46,14 @@ use crate::spectral::{
 
 use super::{Interface, MAX_PASSES, Shading, absorption, interface, sample_direct};
 
-/// Bounces after which Russian roulette starts (Mitsuba's `rr_depth`).
-pub const RR_DEPTH: u32 = 5;
+/// Bounces after which Russian roulette starts. Mitsuba's default is 5;
+/// measured on 64x64 renders (callgrind instructions per sample times the
+/// linear MSE at 64 spp over 8 seeds, against 8192/4096-spp references),
+/// starting after 2 bounces is 1.19x as efficient on `cornell-lambert.ron`
+/// and 1.21x on `spheres.ron` (after 1: 1.18x and 1.17x; after 3: 1.14x
+/// and 1.13x). The cap at 1 instead of Mitsuba's 0.95 costs nothing there
+/// and keeps lossless specular chains exact.
+pub const RR_DEPTH: u32 = 2;
 
 /// The largest probability of reflection at a collapse with continuous
 /// wavelengths: every bin may be totally reflected while wavelengths beyond
@@ -246,7 +254,7 @@ impl PathTracer {
             }
             // 6. Russian roulette.
             if w.bounces >= RR_DEPTH {
-                let q = (w.beta.max_value() * w.eta_scale).min(0.95);
+                let q = (w.beta.max_value() * w.eta_scale).min(1.0);
                 if sampler.next_1d() >= q {
                     break;
                 }
