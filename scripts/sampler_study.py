@@ -9,6 +9,7 @@ rounds of the metric and of the render seconds, and prints a Markdown table:
 - slope: least-squares fit of log(metric) against log(spp) over spp >= --from-spp
   (independent sampling of an unbiased method: about -1);
 - metric at the largest spp for both samplers, and their ratio (equal spp);
+- seconds at the largest spp for both samplers (the cost per sample);
 - time to equal error: the seconds `sobol` needs to reach the error `independent`
   reaches at the largest spp (log-log interpolation between checkpoints), divided by
   the seconds `independent` took (below 1: sobol is faster to that error).
@@ -33,8 +34,8 @@ def main():
     for key, by_spp in data.items():
         curves[key] = [(spp, statistics.median(t for t, _ in v), statistics.median(m for _, m in v))
                        for spp, v in sorted(by_spp.items())]
-    print(f"| scene | method | slope sobol | slope independent | {metric} at {{spp}} spp: sobol / independent | time to independent's final error: sobol / independent |")
-    print("|---|---|---|---|---|---|")
+    print(f"| scene | method | slope sobol | slope independent | {metric} at the largest spp: sobol / independent | seconds there: sobol / independent | time to independent's final error: sobol / independent |")
+    print("|---|---|---|---|---|---|---|")
     for scene, method in sorted({(k[0], k[1]) for k in curves}):
         s, i = curves.get((scene, method, "sobol")), curves.get((scene, method, "independent"))
         if not s or not i:
@@ -54,7 +55,7 @@ def main():
         if t_sobol is None and s[0][2] <= target:
             t_sobol = s[0][1]
         ratio = f"{t_sobol / t_ind:.2f} ({t_sobol:.2f} s / {t_ind:.2f} s)" if t_sobol else "not reached"
-        print(f"| {scene} | {method} | {slope(s):.2f} | {slope(i):.2f} | {s[-1][2]:.3e} / {i[-1][2]:.3e} = {s[-1][2] / i[-1][2]:.2f} at {spp_max} | {ratio} |")
+        print(f"| {scene} | {method} | {slope(s):.2f} | {slope(i):.2f} | {s[-1][2]:.3e} / {i[-1][2]:.3e} = {s[-1][2] / i[-1][2]:.2f} at {spp_max} | {s[-1][1]:.2f} / {i[-1][1]:.2f} | {ratio} |")
 
 if __name__ == "__main__":
     main()

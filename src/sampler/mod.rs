@@ -166,6 +166,8 @@ pub enum Sampler {
 pub struct Sobol {
     key: u64,
     index: u32,
+    /// `index` with its bits reversed (every draw starts from it).
+    index_reversed: u32,
 }
 
 /// SplitMix64's finaliser: a bijective 64-bit mix (Steele et al. 2014).
@@ -202,7 +204,8 @@ impl Sampler {
             SamplerKind::Sobol => {
                 let a = mix64(seed ^ 0x2545_f491_4f6c_dd1d);
                 let key = mix64(a ^ pixel.wrapping_mul(0x9e37_79b9_7f4a_7c15));
-                Sampler::Sobol(Sobol { key, index: pass as u32 })
+                let index = pass as u32;
+                Sampler::Sobol(Sobol { key, index, index_reversed: index.reverse_bits() })
             }
         }
     }
@@ -263,7 +266,7 @@ impl Sobol {
         if !dim.on_table() {
             return unit_24(self.fallback(h));
         }
-        sobol::to_unit(sobol::point_1d(self.index, h))
+        sobol::to_unit(sobol::point_1d(self.index_reversed, h))
     }
 
     #[inline]
@@ -273,7 +276,9 @@ impl Sobol {
             let r = self.fallback(h);
             return Vec2::new(unit_24(r), unit_24(r << 24));
         }
-        let (x, y) = sobol::point_2d(self.index, h, mix64(h ^ 0x5851_f42d_4c95_7f2d));
+        // The second coordinate's seed: 32 more bits from the hash (a multiply spreads them).
+        let h2 = ((h ^ (h >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9) >> 32) as u32;
+        let (x, y) = sobol::point_2d(self.index_reversed, h, h2);
         Vec2::new(sobol::to_unit(x), sobol::to_unit(y))
     }
 }
