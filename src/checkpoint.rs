@@ -227,7 +227,7 @@ impl Checkpoint {
                 env!("CARGO_PKG_VERSION")
             )));
         }
-        let spectral = version % 2 == 0;
+        let spectral = version == FORMAT_1_VERSIONS[1] || version == SPECTRAL_FORMAT_VERSION;
         let format_1 = FORMAT_1_VERSIONS.contains(&version);
         let header_len = u32_at(bytes, 12);
         let payload_len = u64_at(bytes, 16);

@@ -195,8 +195,8 @@ mod tests {
     #[test]
     fn dimension_1_is_pascals_triangle_mod_2() {
         let mut v = 1u32 << 31;
-        for k in 0..32 {
-            assert_eq!(DIM_1[k], v, "column {k}");
+        for (k, &column) in DIM_1.iter().enumerate() {
+            assert_eq!(column, v, "column {k}");
             v ^= v >> 1;
         }
         // The first points of the (unscrambled) sequence, as in every Sobol table.
@@ -213,8 +213,8 @@ mod tests {
     /// `owen(sobol_d(shuffle(i)))` written out.
     #[test]
     fn fast_forms_equal_the_definitions() {
-        for k in 0..32 {
-            assert_eq!(sobol_1_reversed(1 << k).reverse_bits(), DIM_1[k], "column {k}");
+        for (k, &column) in DIM_1.iter().enumerate() {
+            assert_eq!(sobol_1_reversed(1 << k).reverse_bits(), column, "column {k}");
         }
         let mut x = 0x1234_5678u64;
         for _ in 0..10_000 {
@@ -251,7 +251,7 @@ mod tests {
             for m in [1u32, 5, 12] {
                 let mut block: Vec<u32> = (0..1u32 << m).map(|i| shuffle(i, seed)).collect();
                 block.sort_unstable();
-                assert!(block[0] % (1 << m) == 0 && block.windows(2).all(|w| w[1] == w[0] + 1), "m {m}");
+                assert!(block[0].is_multiple_of(1 << m) && block.windows(2).all(|w| w[1] == w[0] + 1), "m {m}");
             }
         }
         // Injective on a sample of 2^16 inputs.
