@@ -14,8 +14,11 @@
 //! 2. stop after `max_bounces` scattering events;
 //! 3. at a dispersive surface, when dispersion is on and the packet has more
 //!    than one wavelength, continue as `N` single-wavelength walks from this
-//!    very hit (each keeps its own throughput, weight and sampler stream
-//!    position; their colours add). The full spectrum (`auto`) first chooses
+//!    very hit (each keeps its own throughput and weight; their colours add;
+//!    they draw the same per-bounce dimensions of the sampler's layout, so
+//!    with `independent` they continue one stream in turn and with `sobol`
+//!    they share their numbers, as a hero packet shares its directions:
+//!    each walk's estimate is unbiased on its own, so their sum is). The full spectrum (`auto`) first chooses
 //!    between reflection, which is the same direction for every wavelength
 //!    and keeps the full spectrum, and refraction, which collapses the path
 //!    to `C` bins drawn in proportion to throughput × visual importance
