@@ -474,6 +474,27 @@ mod tests {
         assert!(e.contains("not a rust-v checkpoint"), "{e}");
     }
 
+    /// The sampler is part of the settings a checkpoint records: a `sobol` and an
+    /// `independent` part do not merge; an unknown format version is a clear error.
+    #[test]
+    fn the_sampler_is_recorded_and_versions_are_checked() {
+        use crate::settings::SamplerKind;
+        let c = sample();
+        let mut other = c.clone();
+        other.settings.sampler = match c.settings.sampler {
+            SamplerKind::Sobol => SamplerKind::Independent,
+            SamplerKind::Independent => SamplerKind::Sobol,
+        };
+        let bytes = other.encode().unwrap();
+        assert_eq!(u32_at(&bytes, 8), FORMAT_VERSION);
+        assert_eq!(Checkpoint::decode(&bytes, Path::new("o.ckpt")).unwrap().settings, other.settings);
+        assert!(c.incompatibility(&other).is_some_and(|why| why.contains("sampler")));
+        let mut bytes = c.encode().unwrap();
+        bytes[8..12].copy_from_slice(&5u32.to_le_bytes());
+        let e = Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap_err().to_string();
+        assert!(e.contains("format version 5") && e.contains("reads versions 1 to 4"), "{e}");
+    }
+
     #[test]
     fn names() {
         assert_eq!(snapshot_path(Path::new("out/cornell.png"), 128), Path::new("out/cornell-00128.png"));
