@@ -8,7 +8,7 @@
 //! checkpoint only has to hold whole passes, their range, the settings, and
 //! which scene they belong to.
 //!
-//! # File format (version 1)
+//! # File format (version 3)
 //! All integers little-endian.
 //!
 //! | bytes | content |
@@ -21,10 +21,16 @@
 //! | H | header: bincode (standard config) of the writer's crate version, the scene file's absolute path and content hash, all [`Settings`], the pass range held, the target pass, the output path |
 //! | P | payload: lz4_flex block (size prepended) of bincode of the film: width, height and 3 fixed-point `i128` sums per pixel |
 //!
-//! A spectral film (`--spectral`) is written as version 2 ([`SPECTRAL_FORMAT_VERSION`]): the
+//! A spectral film (`--spectral`) is written as version 4 ([`SPECTRAL_FORMAT_VERSION`]): the
 //! same layout, its payload followed (inside the same lz4 block) by `width × height × 36`
-//! fixed-point per-bin sums. Colour-only films are written as version 1 exactly as before;
-//! both versions are read.
+//! fixed-point per-bin sums.
+//!
+//! Versions 1 (colour) and 2 (spectral), written before the `sampler` setting existed,
+//! are still read: their header's settings end before `sampler`, and they resume and
+//! merge as `sampler: independent`, the sampler that wrote them (the independent
+//! sampler's numbers are unchanged, so such a resume is bit-exact). Versions 3 and 4
+//! are versions 1 and 2 with the sampler's name after the other settings; a rust-v that
+//! predates them refuses them with its "format version" error.
 //!
 //! Reading checks the magic, the version, the exact length (a truncated
 //! file is reported as such), the checksum, then decodes and validates every
@@ -42,18 +48,21 @@ use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::io::Fnv1a;
 use crate::io::write_atomic;
-use crate::settings::Settings;
+use crate::settings::{Settings, SettingsFormat1};
 
 /// The first 8 bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"RUSTVCKP";
 
 /// The format version this build writes for colour-only films, and reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 3;
 
-/// The format version of a spectral film's checkpoint (`--spectral`): version 1 whose payload
+/// The format version of a spectral film's checkpoint (`--spectral`): version 3 whose payload
 /// also holds 36 fixed-point per-bin sums per pixel after the XYZ sums. Colour-only renders
-/// keep writing version 1, so their checkpoints stay as small and as readable as before.
-pub const SPECTRAL_FORMAT_VERSION: u32 = 2;
+/// write version 3, so their checkpoints stay as small as before.
+pub const SPECTRAL_FORMAT_VERSION: u32 = 4;
+
+/// The versions written before the `sampler` setting (colour, spectral): read, never written.
+pub const FORMAT_1_VERSIONS: [u32; 2] = [1, 2];
 
 /// Bytes before the header: magic, version, two lengths, checksum.
 const PREFIX_LEN: usize = 32;
@@ -81,13 +90,14 @@ pub struct Checkpoint {
 }
 
 /// The header as encoded. [`Settings`] encodes field by field with its enums
-/// as names, so this is byte for byte the layout format 1 has always had.
+/// as names, so this is byte for byte the layout format 1 has always had, with
+/// the sampler after the other settings (`S = SettingsFormat1` reads format 1).
 #[derive(Serialize, Deserialize)]
-struct Header {
+struct Header<S = Settings> {
     crate_version: String,
     scene_path: PathBuf,
     content_hash: u64,
-    settings: Settings,
+    settings: S,
     first_pass: u32,
     end_pass: u32,
     target_end: u32,
@@ -211,13 +221,14 @@ impl Checkpoint {
             return Err(bad(format!("truncated: {} bytes, the fixed header alone is {PREFIX_LEN}", bytes.len())));
         }
         let version = u32_at(bytes, 8);
-        if version != FORMAT_VERSION && version != SPECTRAL_FORMAT_VERSION {
+        if !(1..=SPECTRAL_FORMAT_VERSION).contains(&version) {
             return Err(bad(format!(
-                "format version {version}; this rust-v ({}) reads versions {FORMAT_VERSION} and {SPECTRAL_FORMAT_VERSION}",
+                "format version {version}; this rust-v ({}) reads versions 1 to {SPECTRAL_FORMAT_VERSION}",
                 env!("CARGO_PKG_VERSION")
             )));
         }
-        let spectral = version == SPECTRAL_FORMAT_VERSION;
+        let spectral = version == FORMAT_1_VERSIONS[1] || version == SPECTRAL_FORMAT_VERSION;
+        let format_1 = FORMAT_1_VERSIONS.contains(&version);
         let header_len = u32_at(bytes, 12);
         let payload_len = u64_at(bytes, 16);
         if header_len > MAX_HEADER_LEN {
@@ -241,9 +252,21 @@ impl Checkpoint {
         }
 
         let config = bincode::config::standard();
-        let (h, used): (Header, usize) =
-            bincode::serde::decode_from_slice(header_bytes, config.with_limit::<{ 1 << 20 }>())
-                .map_err(|e| bad(format!("corrupt header: {e}")))?;
+        let header_config = config.with_limit::<{ 1 << 20 }>();
+        let corrupt_header = |e: bincode::error::DecodeError| bad(format!("corrupt header: {e}"));
+        let (h, used): (Header, usize) = if format_1 {
+            let (h, used): (Header<SettingsFormat1>, usize) =
+                bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?;
+            let Header { crate_version, scene_path, content_hash, settings, first_pass, end_pass, target_end, output } =
+                h;
+            let settings = settings.into();
+            (
+                Header { crate_version, scene_path, content_hash, settings, first_pass, end_pass, target_end, output },
+                used,
+            )
+        } else {
+            bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?
+        };
         if used != header_bytes.len() {
             return Err(bad("corrupt header: trailing bytes".into()));
         }
@@ -449,6 +472,27 @@ mod tests {
         }
         let e = Checkpoint::decode(b"\x89PNG\r\n\x1a\n and more", p).unwrap_err().to_string();
         assert!(e.contains("not a rust-v checkpoint"), "{e}");
+    }
+
+    /// The sampler is part of the settings a checkpoint records: a `sobol` and an
+    /// `independent` part do not merge; an unknown format version is a clear error.
+    #[test]
+    fn the_sampler_is_recorded_and_versions_are_checked() {
+        use crate::settings::SamplerKind;
+        let c = sample();
+        let mut other = c.clone();
+        other.settings.sampler = match c.settings.sampler {
+            SamplerKind::Sobol => SamplerKind::Independent,
+            SamplerKind::Independent => SamplerKind::Sobol,
+        };
+        let bytes = other.encode().unwrap();
+        assert_eq!(u32_at(&bytes, 8), FORMAT_VERSION);
+        assert_eq!(Checkpoint::decode(&bytes, Path::new("o.ckpt")).unwrap().settings, other.settings);
+        assert!(c.incompatibility(&other).is_some_and(|why| why.contains("sampler")));
+        let mut bytes = c.encode().unwrap();
+        bytes[8..12].copy_from_slice(&5u32.to_le_bytes());
+        let e = Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap_err().to_string();
+        assert!(e.contains("format version 5") && e.contains("reads versions 1 to 4"), "{e}");
     }
 
     #[test]

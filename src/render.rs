@@ -10,8 +10,9 @@
 //! (a 128×128 image) left a thread idle for half a tile at the end of every
 //! pass, a few per cent of the time.
 //!
-//! Sample `k` of pixel `p` draws its random numbers from the stream
-//! `(seed, p, k)` (the crate-internal `sampler`) and the film's sums are exact integers,
+//! Sample `k` of pixel `p` draws its numbers from the sampler keyed by
+//! `(seed, p, k)` (the crate-internal `sampler`, independent or Sobol with index `k`)
+//! and the film's sums are exact integers,
 //! so the image is bit-identical for any thread count, tile order or batch
 //! size, and a render of passes `a..b` is exactly the corresponding part of
 //! a longer render. No locks or atomics are touched per sample (one relaxed
@@ -32,7 +33,7 @@ use rayon::prelude::*;
 use crate::color::{Spectrum, Xyz};
 use crate::film::{Film, FilmSample, Splat, Tile, tiles};
 use crate::integrator::{Estimator, EstimatorFn, with_estimator};
-use crate::sampler::Sampler;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::Contribution;
 
@@ -214,14 +215,14 @@ fn render_tile<E: Estimator, O: Contribution>(
     tile: &Tile,
     pass: u32,
 ) -> TileSamples<O> {
-    let seed = scene.settings.seed;
+    let (seed, kind) = (scene.settings.seed, scene.settings.sampler);
     let mut out = Vec::with_capacity(tile.len());
     let mut splats = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             let pixel = y as u64 * width as u64 + x as u64;
-            let mut sampler = Sampler::new(seed, pixel, pass as u64);
-            let jitter = sampler.next_2d();
+            let mut sampler = Sampler::of_kind(kind, seed, pixel, pass as u64);
+            let jitter = sampler.get_2d(Dim::FILM);
             let film_pos = Vec2::new(x as f32, y as f32) + jitter;
             out.push(estimator.sample(scene, film_pos, &mut sampler, &mut splats));
         }

@@ -14,12 +14,13 @@
 //!
 //! ```ron
 //! render: (width: 512, height: 512, spp: 256, seed: 0, max_bounces: 8,
-//!          integrator: auto, wavelengths: hero, packet_size: 4),
+//!          integrator: auto, wavelengths: hero, packet_size: 4, sampler: sobol),
 //! ```
 //!
 //! In a checkpoint the settings are encoded field by field in this order
-//! (bincode), with the two enums as their lowercase names, exactly as
-//! format version 1 has always stored them.
+//! (bincode), with the enums as their lowercase names. Checkpoint formats 1
+//! and 2 stored every field before `sampler`, which they predate
+//! (`SettingsFormat1`: such renders drew independent numbers).
 
 use serde::{Deserialize, Serialize};
 
@@ -100,6 +101,16 @@ named_enum! {
         /// Hero packets at continuous wavelengths uniform over 360-830 nm in every scene, every
         /// spectrum interpolated at each wavelength (as Mitsuba 3 and pbrt-v4 integrate colour).
         Continuous = "continuous",
+    }
+}
+
+named_enum! {
+    /// The per-sample number source (the crate-internal `sampler` module).
+    SamplerKind {
+        /// Independent uniform numbers (a PCG32 stream per sample), as before the choice existed.
+        Independent = "independent",
+        /// Owen-scrambled Sobol points, padded: one stratified 1D or 2D point set per draw of a fixed layout.
+        Sobol = "sobol",
     }
 }
 
@@ -220,6 +231,42 @@ settings! {
     wavelengths: WavelengthsKind = WavelengthsKind::Hero, check(any), serde(with = "by_name");
     /// Wavelengths per packet of the spectral integrator, and the wavelengths auto draws where a path refracts into dispersive glass: 1, 2, 4 or 8 (default 4).
     packet_size: u32 = 4, check(packet_size);
+    /// Per-sample numbers: sobol (stratified, Owen-scrambled Sobol) or independent (default sobol: faster to an equal error in the sampler study).
+    sampler: SamplerKind = SamplerKind::Sobol, check(any), serde(with = "by_name");
+}
+
+/// The settings as checkpoint formats 1 and 2 stored them: every field before
+/// `sampler`, which they predate. Their renders drew independent numbers (the
+/// only sampler then), so they read as `sampler: independent`.
+#[derive(Debug, Deserialize)]
+pub(crate) struct SettingsFormat1 {
+    width: u32,
+    height: u32,
+    spp: u32,
+    seed: u64,
+    max_bounces: u32,
+    #[serde(with = "by_name")]
+    integrator: IntegratorKind,
+    #[serde(with = "by_name")]
+    wavelengths: WavelengthsKind,
+    packet_size: u32,
+}
+
+impl From<SettingsFormat1> for Settings {
+    fn from(s: SettingsFormat1) -> Settings {
+        let SettingsFormat1 { width, height, spp, seed, max_bounces, integrator, wavelengths, packet_size } = s;
+        Settings {
+            width,
+            height,
+            spp,
+            seed,
+            max_bounces,
+            integrator,
+            wavelengths,
+            packet_size,
+            sampler: SamplerKind::Independent,
+        }
+    }
 }
 
 /// What the command line needs to know of one setting.
@@ -318,6 +365,9 @@ mod tests {
         for k in WavelengthsKind::ALL {
             assert_eq!(WavelengthsKind::from_name(k.name()), Some(*k));
         }
+        for k in SamplerKind::ALL {
+            assert_eq!(SamplerKind::from_name(k.name()), Some(*k));
+        }
         assert_eq!(IntegratorKind::from_name("bdpt"), Some(IntegratorKind::Bdpt));
         assert_eq!(IntegratorKind::from_name("BDPT"), None);
     }
@@ -358,16 +408,22 @@ mod tests {
         assert_eq!(s.differences(&t), vec!["seed 2 vs 0".to_string(), "wavelengths rgb vs hero".to_string()]);
     }
 
-    /// The header layout of checkpoint format 1: the fields in order, the
-    /// enums as strings (bincode's standard configuration).
+    /// The header layout of checkpoint format 3: the fields in order, the enums
+    /// as strings (bincode's standard configuration); format 1 is the same
+    /// without the sampler, and decodes as `independent`.
     #[test]
-    fn binary_encoding_is_format_1() {
-        let s = Settings { integrator: IntegratorKind::Spectral, ..Settings::default() };
+    fn binary_encoding_is_format_3_and_format_1_reads() {
+        let s = Settings { integrator: IntegratorKind::Spectral, sampler: SamplerKind::Sobol, ..Settings::default() };
         let config = bincode::config::standard();
         let bytes = bincode::serde::encode_to_vec(&s, config).unwrap();
         let old = (512u32, 512u32, 64u32, 0u64, 8u32, "spectral", "hero", 4u32);
-        assert_eq!(bytes, bincode::serde::encode_to_vec(old, config).unwrap());
+        let new = (512u32, 512u32, 64u32, 0u64, 8u32, "spectral", "hero", 4u32, "sobol");
+        assert_eq!(bytes, bincode::serde::encode_to_vec(new, config).unwrap());
         let (back, _): (Settings, usize) = bincode::serde::decode_from_slice(&bytes, config).unwrap();
         assert_eq!(back, s);
+        let old = bincode::serde::encode_to_vec(old, config).unwrap();
+        let (v1, used): (SettingsFormat1, usize) = bincode::serde::decode_from_slice(&old, config).unwrap();
+        assert_eq!(used, old.len());
+        assert_eq!(Settings::from(v1), Settings { sampler: SamplerKind::Independent, ..s });
     }
 }

@@ -76,14 +76,19 @@ fn scene_text(name: &str) -> String {
 /// tracing renders of 4 spp, and from 16 path tracing renders of 4 spp
 /// agree within 4.5 combined standard errors (estimated from the seeds'
 /// spread), which 64 blocks × 2 comparisons pass by chance with
-/// probability > 99.9%; plus 1% on the image mean.
+/// probability > 99.9%; and the image sums within 4.5 combined standard
+/// errors (the blocks' errors added in quadrature). A fixed 1% on the image
+/// mean was here before the sobol sampler: that realization of light
+/// tracing landed 1.2% above path (48 seeds: 0.2804 ± 0.0008 against path's
+/// 0.2785 ± 0.0016, 1.1 standard errors, with the independent sampler
+/// 0.2799 ± 0.0010 against 0.2791 ± 0.0025).
 #[test]
 fn bdpt_lighttrace_and_path_agree_on_the_cornell_box() {
     let text = scene_text("cornell.ron");
     let path = seeded_blocks(&text, IntegratorKind::Path, 32, 4, 16);
     for (integrator, spp, seeds) in [(IntegratorKind::Bdpt, 1, 32), (IntegratorKind::LightTrace, 4, 16)] {
         let other = seeded_blocks(&text, integrator, 32, spp, seeds);
-        let (mut sa, mut sb) = (0.0, 0.0);
+        let (mut sa, mut sb, mut var) = (0.0, 0.0, 0.0);
         for (k, (a, b)) in other.iter().zip(&path).enumerate() {
             let se = (a.1 * a.1 + b.1 * b.1).sqrt();
             assert!(
@@ -94,8 +99,10 @@ fn bdpt_lighttrace_and_path_agree_on_the_cornell_box() {
             );
             sa += a.0;
             sb += b.0;
+            var += se * se;
         }
-        assert!((sa / sb - 1.0).abs() < 0.01, "{integrator:?}: image mean {sa} vs path {sb}");
+        let se = var.sqrt();
+        assert!((sa - sb).abs() < 4.5 * se, "{integrator:?}: image sum {sa} vs path {sb} (se {se})");
     }
 }
 

@@ -15,6 +15,7 @@ mod hostile;
 mod lights;
 mod metrics;
 mod output;
+mod sampler;
 mod scenes;
 mod spectra;
 mod spectral;

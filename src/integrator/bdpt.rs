@@ -96,7 +96,7 @@ use crate::color::{N_BINS, Sampled, Spectrum};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
 use crate::light::Light;
-use crate::sampler::Sampler;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{BinDistribution, Contribution, Lambdas, Readout, bin_importance, continuous_wavelength};
 
@@ -301,7 +301,7 @@ impl Estimator for Bdpt {
             camera_media.clear();
             light_media.clear();
             let track = scene.has_media();
-            let mut wl = Wavelength { u: sampler.next_1d(), continuous: O::CONTINUOUS, drawn: None };
+            let mut wl = Wavelength { u: sampler.get_1d(Dim::wavelength(0)), continuous: O::CONTINUOUS, drawn: None };
             let full = Lambdas::full();
             let (mut l, mut l_single) = (Spectrum::ZERO, 0.0f32);
             if !self.light_only {
@@ -372,8 +372,8 @@ impl Bdpt {
         mut stacks: Option<&mut Vec<MediumStack>>,
         wl: &mut Wavelength,
     ) {
-        let u_light = sampler.next_1d();
-        let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+        let u_light = sampler.get_1d(Dim::EMIT_CHOICE);
+        let (u_pos, u_dir) = (sampler.get_2d(Dim::EMIT_POSITION), sampler.get_2d(Dim::EMIT_DIRECTION));
         let Some((index, pmf)) = scene.choose_light(u_light) else {
             return;
         };
@@ -524,7 +524,8 @@ impl Bdpt {
             }
             1 => {
                 // Next-event estimation: a fresh point on a light.
-                let (u_light, u) = (sampler.next_1d(), sampler.next_2d());
+                let (u_light, u) =
+                    (sampler.get_1d(Dim::light_choice(t as u32 - 2)), sampler.get_2d(Dim::light_sample(t as u32 - 2)));
                 if !connectible(scene, pt) {
                     return NONE;
                 }
@@ -740,7 +741,10 @@ impl Walk {
             if path.len() >= self.max_vertices || bxdf.is_black() {
                 break;
             }
-            let (u, uc) = (sampler.next_2d(), sampler.next_1d());
+            let (u, uc) = (
+                sampler.get_2d(Dim::bsdf(bounces).on_light_path_if(self.importance)),
+                sampler.get_1d(Dim::lobe(bounces).on_light_path_if(self.importance)),
+            );
             let sample = if collapsed || bxdf.dispersion_within(out).is_some() {
                 let one = wl.single();
                 if !collapsed {
@@ -793,7 +797,7 @@ impl Walk {
                 // subpath that has lost nothing (a delta chain through clear
                 // glass) is never cut, so exact cases stay exact.
                 let q = (beta.max_value() * eta_scale / beta_ref).min(1.0);
-                if sampler.next_1d() >= q || q.is_nan() {
+                if sampler.get_1d(Dim::roulette(bounces - 1).on_light_path_if(self.importance)) >= q || q.is_nan() {
                     break;
                 }
                 beta /= q;

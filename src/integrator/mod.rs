@@ -42,8 +42,8 @@ use crate::bxdf::{Bxdf, Crossing, Medium, MediumStack, Outside};
 use crate::color::{Sampled, Spectrum};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
-use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::{Scene, SurfaceHit};
 use crate::settings::{IntegratorKind, WavelengthsKind};
 use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet, sample_packet_continuous};
@@ -109,7 +109,7 @@ impl<const C: usize> Estimator for Packets<C> {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
         let ray = scene.camera.ray(film);
-        let u: [f32; C] = std::array::from_fn(|_| sampler.next_1d());
+        let u: [f32; C] = std::array::from_fn(|i| sampler.get_1d(Dim::wavelength(i)));
         let lambdas = if O::CONTINUOUS && (self.2 || scene.has_dispersion()) {
             sample_packet_continuous::<C>(self.1, u)
         } else {
@@ -348,7 +348,7 @@ pub(crate) struct Surround<'a> {
 /// One next-event estimate at a non-delta surface: a light chosen by power, a
 /// point on it sampled by solid angle or area, a shadow ray (absorbed by the
 /// medium it runs in, `surround`), and the MIS weight against BSDF sampling
-/// (power heuristic) when `mis` is set.
+/// (power heuristic) when `mis` is set. Its numbers are the draws of depth `depth`.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(crate) fn sample_direct<const N: usize>(
@@ -359,10 +359,11 @@ pub(crate) fn sample_direct<const N: usize>(
     lambdas: &Lambdas<N>,
     sampler: &mut Sampler,
     mis: bool,
+    depth: u32,
 ) -> Sampled<N> {
     let zero = Sampled::splat(0.0);
-    let u_light = sampler.next_1d();
-    let u = sampler.next_2d();
+    let u_light = sampler.get_1d(Dim::light_choice(depth));
+    let u = sampler.get_2d(Dim::light_sample(depth));
     let Some((index, pmf)) = scene.choose_light(u_light) else {
         return zero;
     };

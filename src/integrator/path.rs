@@ -14,8 +14,11 @@
 //! 2. stop after `max_bounces` scattering events;
 //! 3. at a dispersive surface, when dispersion is on and the packet has more
 //!    than one wavelength, continue as `N` single-wavelength walks from this
-//!    very hit (each keeps its own throughput, weight and sampler stream
-//!    position; their colours add). The full spectrum (`auto`) first chooses
+//!    very hit (each keeps its own throughput and weight; their colours add;
+//!    they draw the same per-bounce dimensions of the sampler's layout, so
+//!    with `independent` they continue one stream in turn and with `sobol`
+//!    they share their numbers, as a hero packet shares its directions:
+//!    each walk's estimate is unbiased on its own, so their sum is). The full spectrum (`auto`) first chooses
 //!    between reflection, which is the same direction for every wavelength
 //!    and keeps the full spectrum, and refraction, which collapses the path
 //!    to `C` bins drawn in proportion to throughput × visual importance
@@ -37,8 +40,8 @@
 use crate::bxdf::{BsdfSample, Dispersion, MediumStack};
 use crate::color::{N_BINS, Sampled, Spectrum};
 use crate::geometry::Ray;
-use crate::sampler::Sampler;
 use crate::sampler::warp::power_heuristic;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectral::{
     BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated, for_each_rotated_continuous,
@@ -199,7 +202,7 @@ impl PathTracer {
                     let Some(dist) = BinDistribution::new(|b| w.beta[b] * importance[b]) else {
                         break;
                     };
-                    let u = sampler.next_1d();
+                    let u = sampler.get_1d(Dim::collapse_bins(w.bounces));
                     if O::CONTINUOUS {
                         // Continuous wavelengths, each at the interpolated throughput.
                         for_each_rotated_continuous(&dist, self.collapse_to as usize, u, |l1, weight| {
@@ -227,11 +230,11 @@ impl PathTracer {
             // 4. Direct light.
             if !bxdf.is_delta() {
                 let surround = at.surround(scene, &w.media);
-                l += w.beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, true);
+                l += w.beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, true, w.bounces);
             }
             // 5. The next direction.
-            let u = sampler.next_2d();
-            let uc = sampler.next_1d();
+            let u = sampler.get_2d(Dim::bsdf(w.bounces));
+            let uc = sampler.get_1d(Dim::lobe(w.bounces));
             let sample = match (reflect.take(), std::mem::replace(&mut start, Start::Camera), dispersion) {
                 (Some(weight), ..) => Some(mirror(sh.wo, weight)),
                 (None, Start::SplitRefraction, Some(d)) => refraction(d, sh.wo, lambdas),
@@ -255,7 +258,7 @@ impl PathTracer {
             // 6. Russian roulette.
             if w.bounces >= RR_DEPTH {
                 let q = (w.beta.max_value() * w.eta_scale).min(1.0);
-                if sampler.next_1d() >= q {
+                if sampler.get_1d(Dim::roulette(w.bounces - 1)) >= q {
                     break;
                 }
                 w.beta /= q;
@@ -333,13 +336,13 @@ impl PathTracer {
         // Continuous wavelengths beyond 730 nm may refract where every bin is
         // totally reflected: refraction must stay possible.
         let p_reflect = if O::CONTINUOUS { p_reflect.min(MAX_CONTINUOUS_P_REFLECT) } else { p_reflect };
-        if sampler.next_1d() < p_reflect {
+        if sampler.get_1d(Dim::collapse(w.bounces)) < p_reflect {
             let fr = all_fr.unwrap_or_else(|| glass.reflectance(sh.wo, lambdas));
             return Some(fr / p_reflect);
         }
         let p_refract = 1.0 - p_reflect;
         let dist = BinDistribution::new(|b| w.beta[b] * importance[b])?;
-        let u = sampler.next_1d();
+        let u = sampler.get_1d(Dim::collapse_bins(w.bounces));
         if O::CONTINUOUS {
             // Each wavelength at its own λ: the interpolated throughput, the
             // reflectance and index at λ exactly.

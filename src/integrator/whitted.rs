@@ -15,7 +15,7 @@
 
 use crate::color::Sampled;
 use crate::geometry::Ray;
-use crate::sampler::Sampler;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
 
@@ -75,11 +75,12 @@ impl Whitted {
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             if !bxdf.is_delta() {
                 // The diffuse end of E S* D L: direct light only, then stop.
-                l += beta * sample_direct(scene, bxdf, &sh, at.surround(scene, &media), lambdas, sampler, false);
+                let surround = at.surround(scene, &media);
+                l += beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, false, bounces);
                 break;
             }
-            let u = sampler.next_2d();
-            let uc = sampler.next_1d();
+            let u = sampler.get_2d(Dim::bsdf(bounces));
+            let uc = sampler.get_1d(Dim::lobe(bounces));
             let Some(bs) = bxdf.sample_within(sh.wo, u, uc, lambdas, at.outside()) else {
                 break;
             };

@@ -1,24 +1,173 @@
-//! Sampling: the deterministic per-sample random number source
-//! ([`Sampler`]) and the warps from uniform numbers to directions and points
-//! ([`warp`]).
+//! Sampling: the deterministic per-sample number source ([`Sampler`]), the fixed
+//! layout of its dimensions ([`Dim`]), and the warps from uniform numbers to
+//! directions and points ([`warp`]).
 //!
-//! Every camera sample draws its random numbers from a PCG32 stream keyed by
-//! `(seed, pixel, pass)`: the stream's state and increment are hashes of
-//! those three numbers. A sample's numbers therefore do not depend on which
-//! thread rendered it, on the tile order, or on how many passes ran before in
-//! this process; that is what makes renders bit-identical across thread
-//! counts, and resume and merge exact. Dimensions are consumed in the fixed
-//! order the integrator asks for them.
+//! Sample `k` of pixel `p` takes its numbers from a sampler keyed by
+//! `(seed, p, k)`, `k` being the pass index: a sample's numbers do not depend
+//! on which thread rendered it, on the tile order, or on how many passes ran
+//! before in this process. That is what makes renders bit-identical across
+//! thread counts, and resume and merge exact. Two samplers, a closed set
+//! (`--sampler`, the `render` block's `sampler:`; [`SamplerKind`]):
+//!
+//! - **`independent`**: a PCG32 stream whose state and increment are hashes of
+//!   `(seed, p, k)`. It ignores [`Dim`] and hands out numbers in the order the
+//!   integrator asks for them, exactly as before the layout existed, so its
+//!   images are byte-identical to those of rust-v before the `sobol` sampler.
+//! - **`sobol`**: Owen-scrambled, shuffled Sobol points ([`sobol`]), index `k`,
+//!   one padded 1D or 2D point set per [`Dim`], seeded by `(seed, p, dim)`.
+//!   Stratified over the samples of a pixel in every draw; any spp works.
+//!
+//! # The dimension layout
+//! Integrators ask for numbers by purpose and bounce, never in stream order,
+//! so a data-dependent number of draws (a packet split, a collapse, a path
+//! that ends early, BDPT's light subpath) never shifts another draw's
+//! dimension. `depth` counts the surface vertices of a subpath before this one
+//! (0 at the camera ray's first hit).
+//!
+//! | draw | 1D/2D | who |
+//! |---|---|---|
+//! | [`Dim::FILM`] | 2D | the position in the pixel |
+//! | [`Dim::wavelength`]`(i)`, `i < 8` | 1D | packet wavelengths (`spectral`), BDPT's `u_λ` (`i = 0`) |
+//! | [`Dim::light_choice`]`(depth)` | 1D | next-event estimation: which light |
+//! | [`Dim::light_sample`]`(depth)` | 2D | next-event estimation: the point on it |
+//! | [`Dim::bsdf`]`(depth)` | 2D | BSDF sample direction |
+//! | [`Dim::lobe`]`(depth)` | 1D | BSDF lobe choice |
+//! | [`Dim::roulette`]`(depth)` | 1D | Russian roulette |
+//! | [`Dim::collapse`]`(depth)` | 1D | `auto`: reflect or collapse at dispersive glass |
+//! | [`Dim::collapse_bins`]`(depth)` | 1D | `auto`: the rotation of the drawn bins |
+//! | [`Dim::EMIT_CHOICE`], [`Dim::EMIT_POSITION`], [`Dim::EMIT_DIRECTION`] | 1D, 2D, 2D | BDPT's light subpath: the light, a point and a direction leaving it |
+//! | `d.`[`on_light_path`](Dim::on_light_path)`()` | as `d` | a per-bounce draw on BDPT's light subpath (its own block) |
+//!
+//! The walks a packet splits into at a dispersive surface continue with the
+//! same per-bounce draws (their numbers are shared, as a hero packet shares
+//! its directions; each walk's estimate stays unbiased, and so does their sum).
+//! Per-bounce draws of depth [`TABLE_BOUNCES`] and more are off the table: the
+//! `sobol` sampler gives them hashed random numbers of `(seed, p, k, dim)`,
+//! deterministic like everything else.
 
+pub mod sobol;
 pub mod warp;
 
 use glam::Vec2;
 use rand::Rng;
 use rand_pcg::Pcg32;
 
-/// A stream of uniform numbers in [0, 1) for one camera sample.
-pub struct Sampler {
-    rng: Pcg32,
+pub use crate::settings::SamplerKind;
+
+/// Per-bounce draws beyond this depth get hashed random numbers (`sobol`).
+pub const TABLE_BOUNCES: u32 = 16;
+
+/// Per-bounce slots: the stride of a bounce's block in the dimension ids.
+const SLOTS: u64 = 8;
+/// Where the per-bounce blocks start.
+const BOUNCES_AT: u64 = 16;
+/// Added to a per-bounce id on BDPT's light subpath.
+const LIGHT_PATH: u64 = 1 << 40;
+/// Ids from here on are off the table (wavelength draws beyond 8: no packet has them).
+const OFF_TABLE: u64 = 1 << 41;
+
+/// One draw's place in the fixed dimension layout (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Dim(u64);
+
+impl Dim {
+    /// The film position within the pixel (2D).
+    pub const FILM: Dim = Dim(0);
+    /// BDPT: which light the light subpath starts on (1D).
+    pub const EMIT_CHOICE: Dim = Dim(9);
+    /// BDPT: the point on the light (2D).
+    pub const EMIT_POSITION: Dim = Dim(10);
+    /// BDPT: the direction leaving the light (2D).
+    pub const EMIT_DIRECTION: Dim = Dim(11);
+
+    /// Wavelength draw `i` of a packet (1D; `i < 8` is on the table).
+    #[inline]
+    pub fn wavelength(i: usize) -> Dim {
+        Dim(if i < 8 { 1 + i as u64 } else { OFF_TABLE + i as u64 })
+    }
+
+    #[inline]
+    fn bounce(depth: u32, slot: u64) -> Dim {
+        Dim(BOUNCES_AT + SLOTS * depth as u64 + slot)
+    }
+
+    /// Next-event estimation at depth `depth`: which light (1D).
+    #[inline]
+    pub fn light_choice(depth: u32) -> Dim {
+        Dim::bounce(depth, 0)
+    }
+
+    /// Next-event estimation at depth `depth`: the point on the light (2D).
+    #[inline]
+    pub fn light_sample(depth: u32) -> Dim {
+        Dim::bounce(depth, 1)
+    }
+
+    /// The BSDF sample's direction at depth `depth` (2D).
+    #[inline]
+    pub fn bsdf(depth: u32) -> Dim {
+        Dim::bounce(depth, 2)
+    }
+
+    /// The BSDF sample's lobe choice at depth `depth` (1D).
+    #[inline]
+    pub fn lobe(depth: u32) -> Dim {
+        Dim::bounce(depth, 3)
+    }
+
+    /// Russian roulette after the bounce at depth `depth` (1D).
+    #[inline]
+    pub fn roulette(depth: u32) -> Dim {
+        Dim::bounce(depth, 4)
+    }
+
+    /// `auto` at dispersive glass at depth `depth`: reflect, or collapse (1D).
+    #[inline]
+    pub fn collapse(depth: u32) -> Dim {
+        Dim::bounce(depth, 5)
+    }
+
+    /// `auto` at dispersive glass at depth `depth`: the drawn bins' rotation (1D).
+    #[inline]
+    pub fn collapse_bins(depth: u32) -> Dim {
+        Dim::bounce(depth, 6)
+    }
+
+    /// This per-bounce draw on BDPT's light subpath (a block of its own).
+    #[inline]
+    pub fn on_light_path(self) -> Dim {
+        Dim(self.0 | LIGHT_PATH)
+    }
+
+    /// [`Dim::on_light_path`] when `light` is set, else `self`.
+    #[inline]
+    pub fn on_light_path_if(self, light: bool) -> Dim {
+        if light { self.on_light_path() } else { self }
+    }
+
+    /// True when the `sobol` sampler has a point set for this draw.
+    #[inline]
+    fn on_table(self) -> bool {
+        self.0 < OFF_TABLE && (self.0 & (LIGHT_PATH - 1)) < BOUNCES_AT + SLOTS * TABLE_BOUNCES as u64
+    }
+}
+
+/// The number source of one camera sample (see the module doc).
+#[derive(Clone, Debug)]
+pub enum Sampler {
+    /// Independent uniform numbers in request order (dimensions ignored).
+    Independent(Pcg32),
+    /// Padded, Owen-scrambled Sobol points, one set per dimension.
+    Sobol(Sobol),
+}
+
+/// The `sobol` sampler's state: its key (a hash of seed and pixel) and the sample index.
+#[derive(Clone, Copy, Debug)]
+pub struct Sobol {
+    key: u64,
+    index: u32,
+    /// `index` with its bits reversed (every draw starts from it).
+    index_reversed: u32,
 }
 
 /// SplitMix64's finaliser: a bijective 64-bit mix (Steele et al. 2014).
@@ -29,65 +178,110 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The top 24 bits of `x` as a float in [0, 1) (exactly representable, < 1).
+#[inline]
+fn unit_24(x: u64) -> f32 {
+    (x >> 40) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
 impl Sampler {
-    /// The stream of sample `pass` of pixel `pixel` (row-major index) for `seed`.
+    /// The `independent` stream of sample `pass` of pixel `pixel` (row-major index) for `seed`.
     #[inline]
     pub fn new(seed: u64, pixel: u64, pass: u64) -> Self {
         let a = mix64(seed ^ 0x9e37_79b9_7f4a_7c15);
         let b = mix64(a ^ pixel.wrapping_mul(0xd1b5_4a32_d192_ed03));
         let state = mix64(b ^ pass.wrapping_mul(0x8cb9_2ba7_2f3d_8dd7));
         let stream = mix64(state ^ 0x5851_f42d_4c95_7f2d);
-        Sampler { rng: Pcg32::new(state, stream) }
+        Sampler::Independent(Pcg32::new(state, stream))
     }
 
-    /// One uniform number in [0, 1) (24 random bits, so exactly representable and < 1).
+    /// The sampler `kind` for sample `pass` of pixel `pixel` (row-major index) for `seed`.
+    /// The `sobol` sampler's index is the pass (modulo 2^32).
     #[inline]
+    pub fn of_kind(kind: SamplerKind, seed: u64, pixel: u64, pass: u64) -> Self {
+        match kind {
+            SamplerKind::Independent => Sampler::new(seed, pixel, pass),
+            SamplerKind::Sobol => {
+                let a = mix64(seed ^ 0x2545_f491_4f6c_dd1d);
+                let key = mix64(a ^ pixel.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+                let index = pass as u32;
+                Sampler::Sobol(Sobol { key, index, index_reversed: index.reverse_bits() })
+            }
+        }
+    }
+
+    /// One uniform number in [0, 1) for draw `dim` (24 bits: exactly representable and < 1).
+    #[inline]
+    pub fn get_1d(&mut self, dim: Dim) -> f32 {
+        match self {
+            Sampler::Independent(rng) => (rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32),
+            Sampler::Sobol(s) => s.get_1d(dim),
+        }
+    }
+
+    /// Two uniform numbers in [0, 1)² for draw `dim`.
+    #[inline]
+    pub fn get_2d(&mut self, dim: Dim) -> Vec2 {
+        match self {
+            Sampler::Independent(_) => {
+                let x = self.get_1d(dim);
+                Vec2::new(x, self.get_1d(dim))
+            }
+            Sampler::Sobol(s) => s.get_2d(dim),
+        }
+    }
+
+    /// The next number of an `independent` stream, for the tests of other modules
+    /// that want a plain stream ([`Sampler::new`]); dimensions do not matter there.
+    #[cfg(test)]
     pub fn next_1d(&mut self) -> f32 {
-        (self.rng.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        debug_assert!(matches!(self, Sampler::Independent(_)));
+        self.get_1d(Dim::FILM)
     }
 
-    /// Two uniform numbers in [0, 1)².
-    #[inline]
+    /// The next two numbers of an `independent` stream (see [`Sampler::next_1d`]).
+    #[cfg(test)]
     pub fn next_2d(&mut self) -> Vec2 {
-        let x = self.next_1d();
-        Vec2::new(x, self.next_1d())
+        debug_assert!(matches!(self, Sampler::Independent(_)));
+        self.get_2d(Dim::FILM)
+    }
+}
+
+impl Sobol {
+    /// The hash that seeds draw `dim` in this pixel.
+    #[inline]
+    fn seed_of(&self, dim: Dim) -> u64 {
+        mix64(self.key ^ dim.0.wrapping_mul(0xd6e8_feb8_6659_fd93))
+    }
+
+    /// Off the table: a hash of (key, dim, index).
+    #[inline]
+    fn fallback(&self, h: u64) -> u64 {
+        mix64(h ^ (self.index as u64 + 1).wrapping_mul(0x8cb9_2ba7_2f3d_8dd7))
+    }
+
+    #[inline]
+    fn get_1d(&self, dim: Dim) -> f32 {
+        let h = self.seed_of(dim);
+        if !dim.on_table() {
+            return unit_24(self.fallback(h));
+        }
+        sobol::to_unit(sobol::point_1d(self.index_reversed, h))
+    }
+
+    #[inline]
+    fn get_2d(&self, dim: Dim) -> Vec2 {
+        let h = self.seed_of(dim);
+        if !dim.on_table() {
+            let r = self.fallback(h);
+            return Vec2::new(unit_24(r), unit_24(r << 24));
+        }
+        // The second coordinate's seed: 32 more bits from the hash (a multiply spreads them).
+        let h2 = ((h ^ (h >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9) >> 32) as u32;
+        let (x, y) = sobol::point_2d(self.index_reversed, h, h2);
+        Vec2::new(sobol::to_unit(x), sobol::to_unit(y))
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn same_key_same_numbers_different_key_different_numbers() {
-        let draw = |s: u64, p: u64, q: u64| {
-            let mut r = Sampler::new(s, p, q);
-            (0..8).map(|_| r.next_1d()).collect::<Vec<_>>()
-        };
-        assert_eq!(draw(1, 2, 3), draw(1, 2, 3));
-        assert_ne!(draw(1, 2, 3), draw(1, 2, 4));
-        assert_ne!(draw(1, 2, 3), draw(1, 3, 3));
-        assert_ne!(draw(1, 2, 3), draw(2, 2, 3));
-    }
-
-    /// Mean and variance of U[0,1) over 200k draws spread over many streams:
-    /// mean 1/2 with standard error sqrt(1/12/2e5) = 6.5e-4, so 4e-3 is > 6 sigma.
-    #[test]
-    fn numbers_are_uniform() {
-        let (mut sum, mut sum2, mut n) = (0.0f64, 0.0f64, 0usize);
-        for p in 0..2000 {
-            let mut r = Sampler::new(7, p, 0);
-            for _ in 0..100 {
-                let x = r.next_1d() as f64;
-                assert!((0.0..1.0).contains(&x));
-                sum += x;
-                sum2 += x * x;
-                n += 1;
-            }
-        }
-        let mean = sum / n as f64;
-        let var = sum2 / n as f64 - mean * mean;
-        assert!((mean - 0.5).abs() < 4e-3, "mean {mean}");
-        assert!((var - 1.0 / 12.0).abs() < 4e-3, "variance {var}");
-    }
-}
+mod tests;

@@ -138,8 +138,12 @@ fn bubble_is_invisible_from_inside_and_outside() {
             let (mean, se) = mean_and_stderr(&film, 1);
             assert!((mean - 1.0).abs() < 5.0 * se + 2e-3, "{m} from {eye}: Y = {mean}");
             if full_spectrum(m) {
+                // BDPT's pixels are noisier here (standard deviation 0.037 over the
+                // pixels at 32 spp, either sampler, 12 seeds): 0.1 is 2.7 of them and
+                // half the seeds fail it; 0.2 is 5.4.
+                let tol = if m == "bdpt" { 0.2 } else { pixel_tol(m) };
                 let v = y(&film);
-                assert!(v.iter().all(|v| (v - 1.0).abs() < pixel_tol(m)), "{m} from {eye}");
+                assert!(v.iter().all(|v| (v - 1.0).abs() < tol), "{m} from {eye}");
             }
         }
     }

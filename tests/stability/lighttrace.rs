@@ -46,7 +46,10 @@ fn lighttrace_sees_nothing_through_glass() {
 /// sliver of plane in view: at 256 spp the plane (ρ L = 0.5) is still
 /// black, and the sky pixels (L = 1, `s = 1` connections) are a few
 /// fireflies. Asserted: no NaN (as everywhere), the sky's mean is 1 within
-/// 5 standard errors (unbiased, however noisy), the plane is darker than 0.5.
+/// 5 standard errors (unbiased, however noisy), and at most a tenth of the
+/// plane's pixels received any light (the mean is no measure here: one light
+/// path that lands on the plane is a firefly of the mean's order, and the
+/// plane's expected value is 0.5; the sobol sampler's realization has one).
 #[test]
 fn lighttrace_grazing_view_of_a_diffuse_plane() {
     let v = y(&render_str(&grazing_plane(), &method("lighttrace", 256, 16)));
@@ -55,6 +58,7 @@ fn lighttrace_grazing_view_of_a_diffuse_plane() {
     eprintln!(
         "grazing diffuse, lighttrace: plane Y = {plane:.4} ± {se:.4} (want 0.5), sky {sky:.4} ± {se_sky:.4} (want 1)"
     );
-    assert!(plane < 0.5, "plane {plane} ± {se}");
+    let lit = v[40..].iter().filter(|&&x| x > 0.0).count();
+    assert!(lit * 10 <= v[40..].len(), "plane {plane} ± {se}: {lit} pixels lit");
     assert!((sky - 1.0).abs() < 5.0 * se_sky + 0.02, "sky {sky} ± {se_sky}");
 }

@@ -81,7 +81,11 @@ fn priority_decides_which_medium_fills_an_overlap() {
             let (mean, se) = mean_and_stderr(&film, 1);
             assert!((mean - 1.0).abs() < 5.0 * se + 1e-3, "{m}, priorities {a} {b}: overlap visible: {mean} ± {se}");
             if full_spectrum(m) {
-                assert!(y(&film).iter().all(|v| (v - 1.0).abs() < pixel_tol(m)), "{m}, priorities {a} {b}");
+                // A path trapped by total internal reflection between the spheres past 64
+                // bounces is lost: one of 32 samples is 1/32 of a pixel (independent at
+                // 256 spp loses 2 samples in two pixels; sobol at 32 spp one in one).
+                let tol = pixel_tol(m) + 1.0 / 32.0;
+                assert!(y(&film).iter().all(|v| (v - 1.0).abs() < tol), "{m}, priorities {a} {b}");
             }
         }
     }
