@@ -12,10 +12,11 @@
 //! to packed instructions, nine `mulps`/`addps` for 36 bins, with no help. The
 //! reductions do not: a fold is one chain of dependent scalar operations, and
 //! an `any`/`all` with an early exit is 36 compares and branches. The
-//! reductions on the per-ray path ([`Sampled::max_value`],
-//! [`Sampled::min_value`], [`Sampled::is_black`], [`Sampled::has_nan_or_inf`])
-//! are therefore written as [`LANES`] independent partial results combined at
-//! the end, without early exits. Their results are exactly those of the
+//! reductions that always read every bin ([`Sampled::max_value`],
+//! [`Sampled::min_value`], [`Sampled::has_nan_or_inf`]) are therefore written
+//! as [`LANES`] independent partial results combined at the end, without early
+//! exits. [`Sampled::is_black`] keeps its early exit: a spectrum that is not
+//! black almost always says so in its first bin. Their results are exactly those of the
 //! sequential folds (a maximum, a minimum or a flag does not depend on the
 //! order it is taken in), so no image changes. [`Sampled::average`] stays a
 //! sequential sum: a different summation order changes its last bits, it runs
@@ -110,11 +111,13 @@ impl<const N: usize> Sampled<N> {
         self.0.iter().sum::<f32>() / N as f32
     }
 
-    /// True when every value is zero (`+0` or `-0`). Branch-free: the bits of
-    /// every value but its sign are or-ed together.
+    /// True when every value is exactly zero. It stops at the first value that
+    /// is not: a spectrum that is not black almost always shows it in its first
+    /// bin, so this beats a branch-free scan of all bins (which cost 3% more
+    /// instructions in a BDPT render).
     #[inline]
     pub fn is_black(&self) -> bool {
-        self.0.iter().fold(0u32, |a, v| a | (v.to_bits() << 1)) == 0
+        self.0.iter().all(|&v| v == 0.0)
     }
 
     /// True when any value is NaN or infinite (exponent bits all set).
