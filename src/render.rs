@@ -230,8 +230,8 @@ fn render_tile<E: Estimator, O: Contribution>(
 
 /// `splats` ordered by band of `band_rows` pixel rows (`y / band_rows`), so that the film's
 /// bands find theirs by binary search and add them in parallel. A counting sort: two passes
-/// and a copy, a tenth of what a comparison sort by row cost (which was more than the serial
-/// addition it replaced).
+/// and a copy, under half of what a comparison sort by row cost (which was more than the
+/// serial addition it replaced).
 fn by_band<S: Copy>(splats: Vec<Splat<S>>, band_rows: u32) -> Vec<Splat<S>> {
     let band = |s: &Splat<S>| (s.y / band_rows) as usize;
     let bands = splats.iter().map(band).max().map_or(0, |b| b + 1);
