@@ -15,7 +15,9 @@
 //! so the image is bit-identical for any thread count, tile order or batch
 //! size, and a render of passes `a..b` is exactly the corresponding part of
 //! a longer render. No locks or atomics are touched per sample (one relaxed
-//! load of the stop flag per task); allocation is one buffer per task.
+//! load of the stop flag per task); allocation is one buffer per task (and,
+//! for light subpaths' splats, their buffer and the two of their counting
+//! sort by band).
 //!
 //! A render stops early when its `stop` flag is set: tasks not yet started
 //! are skipped, the batch's passes that finished whole (from its first one
@@ -230,7 +232,7 @@ fn render_tile<E: Estimator, O: Contribution>(
 
 /// `splats` ordered by band of `band_rows` pixel rows (`y / band_rows`), so that the film's
 /// bands find theirs by binary search and add them in parallel. A counting sort: two passes
-/// and a copy, under half of what a comparison sort by row cost (which was more than the
+/// and a copy, about 60% of what a comparison sort by row cost (which was more than the
 /// serial addition it replaced).
 fn by_band<S: Copy>(splats: Vec<Splat<S>>, band_rows: u32) -> Vec<Splat<S>> {
     let band = |s: &Splat<S>| (s.y / band_rows) as usize;
