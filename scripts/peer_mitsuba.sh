@@ -15,7 +15,9 @@
 # Rounds are interleaved (Mitsuba, then rust-v, round after round) so both see the same
 # machine load; every side uses all cores (2 threads here). Times are render times as each
 # renderer reports them (Mitsuba: render.py's render_s with the JIT warmed up; rust-v: the
-# "N passes in T s" of its summary), scene loading excluded on both sides.
+# "N passes in T s" of its summary), scene loading excluded on both sides. rust-v's time to
+# the error is its spp times its mean time per spp over the round's renders (16 spp, the
+# guess, the steps), which is less noisy than the one render at that spp.
 #
 #   scripts/peer_mitsuba.sh [BINARY]        # default target/release/rust-v
 #   ROUNDS=3 SEED0=1 scripts/peer_mitsuba.sh
@@ -42,6 +44,8 @@ trap 'rm -rf "$dir"' EXIT
 [ -x "$bin" ] || { echo "no rust-v binary at $bin: cargo build --release" >&2; exit 1; }
 
 log() { echo "$*" >&2; }
+# A render runs in a process substitution, where `exit` cannot stop this script: check its output.
+need() { [ -n "${1:-}" ] && [ -n "${2:-}" ] || { echo "a render failed (see above)" >&2; exit 1; }; }
 median() { printf '%s\n' "$@" | sort -g | awk '{v[NR]=$1} END {print v[int((NR+1)/2)]}'; }
 # The linear MSE of an image against a reference (rust-v compare = the harness's mse_lin).
 mse() { "$bin" compare --json "$1" "$2" | python3 -c 'import json,sys; print(json.load(sys.stdin)["mse_lin"])'; }
@@ -74,31 +78,41 @@ c_llvm_t=() c_llvm_e=() c_scal_t=() c_scal_e=() c_r_t=() c_r_e=() c_r_spp=() c_r
 for r in $(seq "$rounds"); do
   seed=$((seed0 + r - 1))
   read -r lt li < <(mitsuba cornell llvm_ad_spectral 64 "$seed")
+  need "$lt" "$li"
   le=$(mse "$li" "$cref")
   read -r st si < <(mitsuba cornell scalar_spectral 64 "$seed")
+  need "$st" "$si"
   se=$(mse "$si" "$cref")
   # rust-v: a probe at 16 spp, a guess from MSE ~ 1/spp, then one pass up (or down) at a time
   # to the fewest passes that reach the target. Passes are nested (pass k of a pixel draws the
   # same numbers at any spp), so the error sequence is one converging render's.
-  n=16
+  n=16 tot_t=0 tot_n=0
   read -r rt ri < <(rustv "$here/scenes/cornell-lambert.ron" "$n" "$seed")
+  need "$rt" "$ri"
+  tot_t=$(echo "$tot_t + $rt" | bc -l) tot_n=$((tot_n + n))
   re=$(mse "$ri" "$cref")
   log "cornell round $r: llvm $lt s $le, scalar $st s $se; rust-v $n spp $rt s $re"
   guess=$(python3 -c "import math,sys; print(max(1, math.ceil(int(sys.argv[1]) * float(sys.argv[2]) / float(sys.argv[3]))))" "$n" "$re" "$le")
   n=$guess
   read -r rt ri < <(rustv "$here/scenes/cornell-lambert.ron" "$n" "$seed")
+  need "$rt" "$ri"
+  tot_t=$(echo "$tot_t + $rt" | bc -l) tot_n=$((tot_n + n))
   re=$(mse "$ri" "$cref")
   log "  rust-v $n spp: $rt s, MSE $re"
   if [ "$(echo "$re > $le" | bc -l)" = 1 ]; then
     while [ "$(echo "$re > $le" | bc -l)" = 1 ] && [ "$n" -lt $((4 * guess)) ]; do
       n=$((n + 1))
       read -r rt ri < <(rustv "$here/scenes/cornell-lambert.ron" "$n" "$seed")
+      need "$rt" "$ri"
+      tot_t=$(echo "$tot_t + $rt" | bc -l) tot_n=$((tot_n + n))
       re=$(mse "$ri" "$cref")
       log "  rust-v $n spp: $rt s, MSE $re"
     done
   else
     while [ "$n" -gt 1 ]; do
       read -r pt pi < <(rustv "$here/scenes/cornell-lambert.ron" $((n - 1)) "$seed")
+      need "$pt" "$pi"
+      tot_t=$(echo "$tot_t + $pt" | bc -l) tot_n=$((tot_n + n - 1))
       pe=$(mse "$pi" "$cref")
       log "  rust-v $((n - 1)) spp: $pt s, MSE $pe"
       [ "$(echo "$pe <= $le" | bc -l)" = 1 ] || break
@@ -106,6 +120,10 @@ for r in $(seq "$rounds"); do
     done
   fi
   c_llvm_t+=("$lt") c_llvm_e+=("$le") c_scal_t+=("$st") c_scal_e+=("$se")
+  # rust-v's time at n spp: n times its mean time per spp over all of this round's renders
+  # (a render's time is linear in its passes; one render's time alone is noisier).
+  rt=$(echo "$n * $tot_t / $tot_n" | bc -l)
+  log "  rust-v time to the error: $n spp x $(echo "$tot_t / $tot_n" | bc -l | cut -c1-6) s per spp = $rt s"
   c_r_t+=("$rt") c_r_e+=("$re") c_r_spp+=("$n")
   c_ratio_llvm+=("$(echo "$rt / $lt" | bc -l)") c_ratio_scal+=("$(echo "$rt / $st" | bc -l)")
 done
@@ -133,8 +151,10 @@ g_llvm_t=() g_llvm_e=() g_r_t=() g_r_e=() g_ratio=()
 for r in $(seq "$rounds"); do
   seed=$((seed0 + r - 1))
   read -r lt li < <(mitsuba glass-spheres llvm_ad_spectral 64 "$seed")
+  need "$lt" "$li"
   le=$(mse "$li" "$gref")
   read -r rt ri < <(rustv "$gscene" 100000 "$seed" --time "$lt")
+  need "$rt" "$ri"
   re=$(mse "$ri" "$gref")
   log "glass-spheres round $r: llvm $lt s $le, rust-v $rt s $re ($(sed -n 's/.*(\([0-9]*\) passes.*/\1/p' "$dir/r.err" | tail -1) spp)"
   g_llvm_t+=("$lt") g_llvm_e+=("$le") g_r_t+=("$rt") g_r_e+=("$re") g_ratio+=("$(echo "$re / $le" | bc -l)")
