@@ -1,7 +1,8 @@
 //! Render throughput: samples per second on the committed scenes at 128x128,
 //! on 1 and 2 threads, and the scaling ratio, for the full-spectrum
-//! integrators (`path`, `auto` collapsing to 4 or 8) and hero packets of 4
-//! and 8 wavelengths.
+//! integrators (`path`, `auto` collapsing to 4 or 8), hero packets of 4
+//! and 8 wavelengths, and the bidirectional ones (`bdpt`, `lighttrace`, whose
+//! splats the film adds in parallel bands).
 //!
 //! Each method runs 5 rounds of one 1-thread and one 2-thread render of 32
 //! passes, alternating, so that both see the same machine load; the table
@@ -46,6 +47,8 @@ fn main() {
             ("auto-8", IntegratorKind::Auto, 8),
             ("hero-4", IntegratorKind::Spectral, 4),
             ("hero-8", IntegratorKind::Spectral, 8),
+            ("bdpt", IntegratorKind::Bdpt, 4),
+            ("lighttrace", IntegratorKind::LightTrace, 4),
         ];
         for (name, integrator, packet) in methods {
             let overrides = SettingsPatch {

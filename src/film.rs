@@ -328,17 +328,23 @@ impl Film {
     }
 
     /// Adds whole passes of samples of `tiles` (row-major tiles of edge
-    /// `tile_size`, as [`tiles`] makes them): `samples` holds one buffer per
+    /// `tile_size`, as [`tiles`] makes them), and splats: `samples` holds one buffer per
     /// tile per pass, pass-major (`samples[p * tiles.len() + k]` belongs to
-    /// `tiles[k]` in the `p`-th pass). Each band of tile rows is added in
+    /// `tiles[k]` in the `p`-th pass); `splats` holds lists of splats, each ordered
+    /// by band (`y / tile_size`). Each band of tile rows is added in
     /// parallel: bands own disjoint pixel rows, and integer sums do not depend
     /// on the order of the additions, so the sums are those of adding tile by
-    /// tile, pass by pass. The caller records the passes with `end_pass`.
-    /// Returns the invalid samples.
+    /// tile, pass by pass, then the splats one by one (`add_splats`).
+    /// A band finds its splats in each list by binary search, so splats cost no
+    /// serial time (adding them after the parallel loop, on one thread, was 3% of
+    /// a light-tracing render: a 1.94x ceiling on two threads).
+    /// The caller records the passes with `end_pass`.
+    /// Returns the invalid samples and splats.
     pub(crate) fn add_tiles_parallel<S: FilmSample>(
         &mut self,
         tiles: &[Tile],
         samples: &[Vec<S>],
+        splats: &[Vec<Splat<S>>],
         tile_size: u32,
     ) -> usize {
         use rayon::prelude::*;
@@ -346,10 +352,12 @@ impl Film {
         let width = self.width;
         let tiles_x = width.div_ceil(tile_size).max(1) as usize;
         let band_len = width as usize * tile_size as usize;
+        debug_assert!(splats.iter().all(|l| l.is_sorted_by_key(|s| s.y / tile_size)), "splats must be ordered by band");
         let add_band = |band: usize, rows: &mut [[i128; 3]], mut spec: Option<&mut [[i128; N_BINS]]>| {
             let first_row = band as u32 * tile_size;
+            let end_row = first_row + (rows.len() / width as usize) as u32;
             let band_tiles = band * tiles_x..((band + 1) * tiles_x).min(tiles.len());
-            samples
+            let tiled = samples
                 .chunks(tiles.len())
                 .map(|pass| {
                     band_tiles
@@ -357,7 +365,19 @@ impl Film {
                         .map(|k| add_tile_to_rows(rows, spec.as_deref_mut(), width, first_row, &tiles[k], &pass[k]))
                         .sum::<usize>()
                 })
-                .sum::<usize>()
+                .sum::<usize>();
+            let mut splatted = 0;
+            for list in splats {
+                let b = band as u32;
+                let mine =
+                    list.partition_point(|s| s.y / tile_size < b)..list.partition_point(|s| s.y / tile_size <= b);
+                // The last band's list also holds splats below the film (dropped, as off-film splats are).
+                for s in list[mine].iter().filter(|s| s.x < width && s.y < end_row) {
+                    let i = (s.y - first_row) as usize * width as usize + s.x as usize;
+                    splatted += add_sample(&mut rows[i], spec.as_deref_mut().map(|spec| &mut spec[i]), &s.value);
+                }
+            }
+            tiled + splatted
         };
         match self.spectral.as_mut() {
             None => self.sums.par_chunks_mut(band_len).enumerate().map(|(band, rows)| add_band(band, rows, None)).sum(),
@@ -374,7 +394,9 @@ impl Film {
     /// Adds splats to their pixels. Like samples, they are summed in fixed
     /// point, so the result does not depend on the order of the splats or of
     /// the calls; non-finite ones are dropped and counted, oversized ones
-    /// clamped and counted (the return value).
+    /// clamped and counted (the return value). (The renderer adds splats with the
+    /// samples in [`Film::add_tiles_parallel`]; this is the tests' reference.)
+    #[cfg(test)]
     pub(crate) fn add_splats<S: FilmSample>(&mut self, splats: &[Splat<S>]) -> usize {
         let mut bad = 0;
         for s in splats {
@@ -543,9 +565,9 @@ mod tests {
         assert_eq!(f.add_tile(&t, &[Xyz::new(1e30, 0.0, 0.0)]), 1);
     }
 
-    /// Batches of passes added band by band in parallel give the sums of
-    /// adding every tile of every pass one at a time (odd sizes, partial
-    /// tiles, an invalid sample counted once).
+    /// Batches of passes and splats added band by band in parallel give the sums of
+    /// adding every tile of every pass one at a time, then every splat (odd sizes, partial
+    /// tiles, an invalid sample and an invalid splat counted once, splats off the film dropped).
     #[test]
     fn parallel_batches_equal_tile_by_tile_addition() {
         let (w, h, size) = (37, 21, 8);
@@ -568,9 +590,26 @@ mod tests {
         for (j, s) in samples.iter().enumerate() {
             invalid += serial.add_tile(&ts[j % ts.len()], s);
         }
+        // Splats anywhere, some outside the film (dropped) and one NaN (counted), in lists
+        // ordered by band as the renderer makes them.
+        let mut splats: Vec<Vec<Splat<Xyz>>> = (0..4)
+            .map(|l| {
+                (0..50u32)
+                    .map(|i| {
+                        let (x, y) = ((i * 7 + l * 3) % (w + 2), (i * 5 + l * 11) % (h + 3));
+                        let v = if l == 2 && i == 9 { f32::NAN } else { (i + l) as f32 * 0.37 - 4.0 };
+                        Splat { x, y, value: Xyz::new(v, 0.5 * v, v * v) }
+                    })
+                    .collect()
+            })
+            .collect();
+        for l in &splats {
+            invalid += serial.add_splats(l);
+        }
+        splats.iter_mut().for_each(|l| l.sort_by_key(|s| s.y / size));
         let mut parallel = Film::new(w, h);
-        assert_eq!(parallel.add_tiles_parallel(&ts, &samples, size), invalid);
-        assert!(invalid >= 1);
+        assert_eq!(parallel.add_tiles_parallel(&ts, &samples, &splats, size), invalid);
+        assert!(invalid >= 2);
         assert_eq!(parallel.sums(), serial.sums());
     }
 
