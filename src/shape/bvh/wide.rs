@@ -41,34 +41,79 @@ const EMPTY: u32 = u32::MAX;
 /// Most blocks a mesh can have (the rest of a reference's bits).
 pub(crate) const MAX_BLOCKS: usize = BLOCK_MASK as usize;
 
-/// Four children: boxes as `b[0 = min, 1 = max][axis][lane]`, then their references
-/// (a node index, a leaf, or [`EMPTY`] with an empty box).
+/// Four children in one 64-byte cache line: their boxes quantised to 8 bits per plane on
+/// a grid of the node (`origin + q * scale` per axis, `scale` a power of two), as
+/// `q[0 = min, 1 = max][axis][lane]`, then their references (a node index, a leaf, or
+/// [`EMPTY`]). The grid boxes contain the true boxes (see [`Node4::set_all`]), so the
+/// slab test on them only ever enters more boxes than on the true ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 struct Node4 {
-    b: [[[f32; 4]; 3]; 2],
+    origin: [f32; 3],
+    scale: [f32; 3],
     child: [u32; 4],
+    q: [[[u8; 4]; 3]; 2],
 }
 
-const _: () = assert!(std::mem::size_of::<Node4>() == 128 && std::mem::size_of::<Tri4>() == 144);
+const _: () = assert!(std::mem::size_of::<Node4>() == 64 && std::mem::size_of::<Tri4>() == 144);
+
+/// `2^e` for `e` in `[-149, 127]` (subnormal below -126).
+fn pow2(e: i32) -> f32 {
+    let e = e.clamp(-149, 127);
+    if e >= -126 { f32::from_bits(((e + 127) as u32) << 23) } else { f32::from_bits(1 << (e + 149)) }
+}
+
+/// The grid plane `q` of an axis, computed exactly as traversal computes it.
+#[inline(always)]
+fn plane(origin: f32, scale: f32, q: u8) -> f32 {
+    origin + f32::from(q) * scale
+}
 
 impl Node4 {
-    const EMPTY: Node4 = Node4 { b: [[[f32::INFINITY; 4]; 3], [[f32::NEG_INFINITY; 4]; 3]], child: [EMPTY; 4] };
-
-    fn set(&mut self, lane: usize, bounds: Aabb, child: u32) {
+    /// A node over `kids` (one to four children: true box and reference). The grid origin
+    /// is the union's minimum, the scale the smallest power of two whose 255 steps reach
+    /// its maximum; every child's planes are rounded outwards and then checked with the
+    /// traversal's own arithmetic, so the grid box contains the true box (if the true box
+    /// is finite; non-finite boxes do not occur, meshes reject such vertices).
+    fn set_all(kids: &[(Aabb, u32)]) -> Node4 {
+        let mut n = Node4 { origin: [0.0; 3], scale: [1.0; 3], child: [EMPTY; 4], q: [[[255; 4]; 3], [[0; 4]; 3]] };
+        let all = kids.iter().fold(Aabb::EMPTY, |b, k| b.union(&k.0));
         for a in 0..3 {
-            self.b[0][a][lane] = bounds.min[a];
-            self.b[1][a][lane] = bounds.max[a];
+            let (lo, hi) = (all.min[a], all.max[a]);
+            // Start one below the estimate (it may be a step too coarse), then coarsen
+            // until the top plane reaches `hi`; 2^127 * 255 is infinite, so this ends.
+            let est = ((hi - lo) / 255.0).log2().ceil();
+            let mut e = if est.is_finite() { est as i32 - 1 } else { -149 }.clamp(-149, 127);
+            while e < 127 && plane(lo, pow2(e), 255) < hi {
+                e += 1;
+            }
+            let s = pow2(e);
+            n.origin[a] = lo;
+            n.scale[a] = s;
+            for (l, (b, _)) in kids.iter().enumerate() {
+                // Saturating casts: NaN gives 0, out of range the nearest end.
+                let mut ql = ((b.min[a] - lo) / s).floor().clamp(0.0, 255.0) as u8;
+                while ql > 0 && plane(lo, s, ql) > b.min[a] {
+                    ql -= 1;
+                }
+                let mut qh = ((b.max[a] - lo) / s).ceil().clamp(0.0, 255.0) as u8;
+                while qh < 255 && plane(lo, s, qh) < b.max[a] {
+                    qh += 1;
+                }
+                n.q[0][a][l] = ql;
+                n.q[1][a][l] = qh;
+            }
         }
-        self.child[lane] = child;
+        for (l, k) in kids.iter().enumerate() {
+            n.child[l] = k.1;
+        }
+        n
     }
 
+    /// The grid box of child `lane` (it contains the child's true box).
     fn child_box(&self, lane: usize) -> Aabb {
-        let b = &self.b;
-        Aabb {
-            min: Vec3::new(b[0][0][lane], b[0][1][lane], b[0][2][lane]),
-            max: Vec3::new(b[1][0][lane], b[1][1][lane], b[1][2][lane]),
-        }
+        let p = |m: usize, a: usize| plane(self.origin[a], self.scale[a], self.q[m][a][lane]);
+        Aabb { min: Vec3::new(p(0, 0), p(0, 1), p(0, 2)), max: Vec3::new(p(1, 0), p(1, 1), p(1, 2)) }
     }
 }
 
@@ -120,12 +165,13 @@ impl RayBox4 {
         let mut t0 = [0.0f32; 4];
         let mut t1 = [t_max; 4];
         for a in 0..3 {
-            let near = &n.b[self.neg[a]][a];
-            let far = &n.b[1 - self.neg[a]][a];
+            let near = &n.q[self.neg[a]][a];
+            let far = &n.q[1 - self.neg[a]][a];
             let (o, inv) = (self.o[a], self.inv[a]);
+            let (org, s) = (n.origin[a], n.scale[a]);
             for l in 0..4 {
-                let ta = (near[l] - o) * inv;
-                let tb = (far[l] - o) * inv * ROBUST;
+                let ta = (plane(org, s, near[l]) - o) * inv;
+                let tb = (plane(org, s, far[l]) - o) * inv * ROBUST;
                 // Written so that a NaN slab value leaves t0/t1 unchanged (maxps/minps).
                 t0[l] = if ta > t0[l] { ta } else { t0[l] };
                 t1[l] = if tb < t1[l] { tb } else { t1[l] };
@@ -400,11 +446,12 @@ impl Collapse<'_> {
             }
         }
         let me = self.out.nodes.len();
-        self.out.nodes.push(Node4::EMPTY);
+        self.out.nodes.push(Node4::set_all(&[]));
+        let mut lanes = [(Aabb::EMPTY, EMPTY); 4];
         for (lane, &k) in kids.iter().enumerate() {
-            let r = self.subtree(k);
-            self.out.nodes[me].set(lane, self.bin[k].aabb(), r);
+            lanes[lane] = (self.bin[k].aabb(), self.subtree(k));
         }
+        self.out.nodes[me] = Node4::set_all(&lanes[..kids.len()]);
         me as u32
     }
 }
@@ -476,6 +523,80 @@ mod tests {
             assert_eq!(w.occluded(&ray, t_max), want.is_some(), "ray {i}: occluded");
         }
         hits
+    }
+
+    /// The slab test on a true box, as the uncompressed nodes did it (the binary tree's
+    /// test): entry distance or infinity.
+    fn entry_exact(rb: &RayBox4, b: &Aabb, t_max: f32) -> f32 {
+        let (mut t0, mut t1) = (0.0f32, t_max);
+        for a in 0..3 {
+            let (near, far) = if rb.neg[a] == 1 { (b.max[a], b.min[a]) } else { (b.min[a], b.max[a]) };
+            let ta = (near - rb.o[a]) * rb.inv[a];
+            let tb = (far - rb.o[a]) * rb.inv[a] * ROBUST;
+            t0 = if ta > t0 { ta } else { t0 };
+            t1 = if tb < t1 { tb } else { t1 };
+        }
+        if t0 <= t1 { t0 } else { f32::INFINITY }
+    }
+
+    #[test]
+    fn quantised_boxes_contain_the_true_boxes_and_lose_no_ray() {
+        let mut rng = Pcg32::new(77, 1);
+        let mut entered = 0;
+        for case in 0..4000 {
+            let scale = [1e-40f32, 1e-12, 1.0, 1e9, 1e30][case % 5];
+            // Far from the origin, the grid's planes round to the coordinates' ulp.
+            let offset = if case % 3 == 0 { Vec3::splat(1e6 * scale) } else { Vec3::ZERO };
+            let p = |rng: &mut Pcg32| (Vec3::new(uniform(rng), uniform(rng), uniform(rng)) * 2.0 - 1.0) * scale;
+            let n = 1 + case % 4;
+            let kids: Vec<(Aabb, u32)> = (0..n)
+                .map(|k| {
+                    let mut b = Aabb::new(offset + p(&mut rng), offset + p(&mut rng));
+                    match (case / 4 + k) % 7 {
+                        0 => b.max = b.min,        // a point
+                        1 => b.max.y = b.min.y,    // flat
+                        _ => {}
+                    }
+                    (b, k as u32)
+                })
+                .collect();
+            let node = Node4::set_all(&kids);
+            for (l, (b, _)) in kids.iter().enumerate() {
+                let g = node.child_box(l);
+                assert!(g.min.cmple(b.min).all() && g.max.cmpge(b.max).all(), "case {case} lane {l}: {g:?} {b:?}");
+                if offset == Vec3::ZERO && scale >= 1e-12 {
+                    // Tight: within two grid steps of the true planes, steps at most twice
+                    // the union's extent / 255.
+                    let all = kids.iter().fold(Aabb::EMPTY, |u, k| u.union(&k.0));
+                    for a in 0..3 {
+                        let s = node.scale[a];
+                        assert!(s <= 2.0 * (all.max[a] - all.min[a]) / 255.0 * 1.001 || s <= f32::MIN_POSITIVE);
+                        assert!(b.min[a] - g.min[a] <= 2.0 * s && g.max[a] - b.max[a] <= 2.0 * s, "case {case}");
+                    }
+                }
+            }
+            for i in 0..20 {
+                let o = offset + p(&mut rng) * 2.0;
+                let mut d = random_dir(&mut rng);
+                if i % 5 == 0 {
+                    d = [Vec3::X, -Vec3::Y, Vec3::new(0.0, -0.0, 1.0)][i / 5 % 3];
+                } else if i % 2 == 1 {
+                    // Aimed at a child's centre: most of these enter.
+                    d = (kids[i % n].0.centroid() - o).normalize_or(Vec3::Z);
+                }
+                let rb = RayBox4::new(&Ray::new(o, d));
+                let t_max = if i % 2 == 0 { f32::INFINITY } else { uniform(&mut rng) * 3.0 * scale };
+                let e = rb.entry(&node, t_max);
+                for (l, (b, _)) in kids.iter().enumerate() {
+                    let want = entry_exact(&rb, b, t_max);
+                    if want < f32::INFINITY {
+                        entered += 1;
+                        assert!(e[l] <= want, "case {case} ray {i} lane {l}: {} > {want}", e[l]);
+                    }
+                }
+            }
+        }
+        assert!(entered > 10_000, "{entered}");
     }
 
     #[test]
