@@ -1,22 +1,25 @@
-//! The triangle BVH of meshes: 4-wide nodes of one 128-byte, cache-line-aligned block
-//! (the four children's boxes as `[min/max][axis][lane]` arrays of `f32`, then the four
-//! child references), leaves of [`Tri4`] blocks, closest-hit traversal that enters the
-//! nearest child first, and any-hit traversal for shadow rays.
+//! The triangle BVH of meshes: 8-wide nodes of one 128-byte, cache-line-aligned block
+//! (the eight children's boxes quantised to 8 bits per plane on a power-of-two grid of
+//! the node, then the eight child references), leaves of [`Tri4`] blocks, closest-hit
+//! traversal that enters the nearest child first, and any-hit traversal for shadow rays.
+//! The quantised boxes contain the true ones, so the box test only becomes more
+//! conservative and the triangle test decides every hit as before.
 //!
 //! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
-//! grandchildren (or, beside a leaf child, its other child's children, then the children
-//! of the largest of those), and a subtree of at most four triangles becomes one leaf
-//! block. Leaves keep the binary tree's slot order, so the triangles' storage order (and
-//! `Hit::prim`) is the binary tree's; the tree is as deterministic as that build.
+//! grandchildren (or, beside a leaf child, its other child's children), then keeps
+//! replacing its largest child (by area) that is not a leaf by that child's two children
+//! until it has eight; a subtree of at most four triangles becomes one leaf block. Leaves
+//! keep the binary tree's slot order, so the triangles' storage order (and `Hit::prim`)
+//! is the binary tree's; the tree is as deterministic as that build.
 //!
 //! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
 //! under 32 bytes per triangle, the vertices live in the blocks.
 //!
 //! Traversal stack: every node below the root sits at least two binary levels under its
 //! parent node, so a binary tree of depth below [`BINARY_DEPTH`] gives at most
-//! `BINARY_DEPTH / 2` node levels, and three pending siblings per level fit [`STACK`].
+//! `BINARY_DEPTH / 2` node levels, and seven pending siblings per level fit [`STACK`].
 
-// Lane loops `for l in 0..4` index several arrays by lane on purpose: that is the form the
+// Lane loops `for l in 0..W` index several arrays by lane on purpose: that is the form the
 // compiler vectorises.
 #![allow(clippy::needless_range_loop)]
 
@@ -27,10 +30,12 @@ use crate::geometry::{Aabb, Ray};
 use crate::shape::triangle::TriRay;
 use glam::Vec3;
 
+/// Children per node.
+const W: usize = 8;
 /// Depth limit of the binary tree that is collapsed (see the module doc).
 const BINARY_DEPTH: u32 = 42;
-/// Traversal stack entries: three pending children per node level, plus one.
-const STACK: usize = 3 * (BINARY_DEPTH as usize / 2) + 1;
+/// Traversal stack entries: `W - 1` pending children per node level, plus one.
+const STACK: usize = (W - 1) * (BINARY_DEPTH as usize / 2) + 1;
 /// Reference flag of a leaf; its bits 28-30 hold the block count minus one and bits
 /// 0-27 the first block.
 const LEAF: u32 = 1 << 31;
@@ -41,21 +46,21 @@ const EMPTY: u32 = u32::MAX;
 /// Most blocks a mesh can have (the rest of a reference's bits).
 pub(crate) const MAX_BLOCKS: usize = BLOCK_MASK as usize;
 
-/// Four children in one 64-byte cache line: their boxes quantised to 8 bits per plane on
+/// Eight children in two 64-byte cache lines: their boxes quantised to 8 bits per plane on
 /// a grid of the node (`origin + q * scale` per axis, `scale` a power of two), as
 /// `q[0 = min, 1 = max][axis][lane]`, then their references (a node index, a leaf, or
-/// [`EMPTY`]). The grid boxes contain the true boxes (see [`Node4::set_all`]), so the
+/// [`EMPTY`]). The grid boxes contain the true boxes (see [`WideNode::set_all`]), so the
 /// slab test on them only ever enters more boxes than on the true ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-struct Node4 {
+struct WideNode {
     origin: [f32; 3],
     scale: [f32; 3],
-    child: [u32; 4],
-    q: [[[u8; 4]; 3]; 2],
+    child: [u32; W],
+    q: [[[u8; W]; 3]; 2],
 }
 
-const _: () = assert!(std::mem::size_of::<Node4>() == 64 && std::mem::size_of::<Tri4>() == 144);
+const _: () = assert!(std::mem::size_of::<WideNode>() == 128 && std::mem::size_of::<Tri4>() == 144);
 
 /// `2^e` for `e` in `[-149, 127]` (subnormal below -126).
 fn pow2(e: i32) -> f32 {
@@ -69,14 +74,14 @@ fn plane(origin: f32, scale: f32, q: u8) -> f32 {
     origin + f32::from(q) * scale
 }
 
-impl Node4 {
+impl WideNode {
     /// A node over `kids` (one to four children: true box and reference). The grid origin
     /// is the union's minimum, the scale the smallest power of two whose 255 steps reach
     /// its maximum; every child's planes are rounded outwards and then checked with the
     /// traversal's own arithmetic, so the grid box contains the true box (if the true box
     /// is finite; non-finite boxes do not occur, meshes reject such vertices).
-    fn set_all(kids: &[(Aabb, u32)]) -> Node4 {
-        let mut n = Node4 { origin: [0.0; 3], scale: [1.0; 3], child: [EMPTY; 4], q: [[[255; 4]; 3], [[0; 4]; 3]] };
+    fn set_all(kids: &[(Aabb, u32)]) -> WideNode {
+        let mut n = WideNode { origin: [0.0; 3], scale: [1.0; 3], child: [EMPTY; W], q: [[[255; W]; 3], [[0; W]; 3]] };
         let all = kids.iter().fold(Aabb::EMPTY, |b, k| b.union(&k.0));
         for a in 0..3 {
             let (lo, hi) = (all.min[a], all.max[a]);
@@ -133,7 +138,7 @@ pub struct TriangleHit {
 /// A 4-wide BVH that stores its triangles (see the module doc).
 #[derive(Clone, Debug)]
 pub struct WideBvh {
-    nodes: Vec<Node4>,
+    nodes: Vec<WideNode>,
     blocks: Vec<Tri4>,
     /// Slot of each block's lane 0; the other lanes follow.
     block_first: Vec<u32>,
@@ -144,32 +149,32 @@ pub struct WideBvh {
 }
 
 /// Per-ray data of the 4-wide slab test.
-struct RayBox4 {
+struct RayBoxW {
     o: [f32; 3],
     inv: [f32; 3],
     neg: [usize; 3],
 }
 
-impl RayBox4 {
+impl RayBoxW {
     #[inline(always)]
-    fn new(ray: &Ray) -> RayBox4 {
+    fn new(ray: &Ray) -> RayBoxW {
         // As in the binary tree: 1/±0 = ±inf, NaN slab values are ignored.
         let inv = (Vec3::ONE / ray.dir).to_array();
-        RayBox4 { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
+        RayBoxW { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
     }
 
     /// Entry distance into each child's box if the ray hits it with `t` in `[0, t_max]`,
     /// else infinity: the binary tree's slab test, lane by lane.
     #[inline(always)]
-    fn entry(&self, n: &Node4, t_max: f32) -> [f32; 4] {
-        let mut t0 = [0.0f32; 4];
-        let mut t1 = [t_max; 4];
+    fn entry(&self, n: &WideNode, t_max: f32) -> [f32; W] {
+        let mut t0 = [0.0f32; W];
+        let mut t1 = [t_max; W];
         for a in 0..3 {
             let near = &n.q[self.neg[a]][a];
             let far = &n.q[1 - self.neg[a]][a];
             let (o, inv) = (self.o[a], self.inv[a]);
             let (org, s) = (n.origin[a], n.scale[a]);
-            for l in 0..4 {
+            for l in 0..W {
                 let ta = (plane(org, s, near[l]) - o) * inv;
                 let tb = (plane(org, s, far[l]) - o) * inv * ROBUST;
                 // Written so that a NaN slab value leaves t0/t1 unchanged (maxps/minps).
@@ -177,8 +182,8 @@ impl RayBox4 {
                 t1[l] = if tb < t1[l] { tb } else { t1[l] };
             }
         }
-        let mut e = [f32::INFINITY; 4];
-        for l in 0..4 {
+        let mut e = [f32::INFINITY; W];
+        for l in 0..W {
             e[l] = if t0[l] <= t1[l] { t0[l] } else { f32::INFINITY };
         }
         e
@@ -249,7 +254,7 @@ impl WideBvh {
     /// Bytes of the nodes and the index data (each block's first slot, the slot order);
     /// the vertices are [`WideBvh::triangle_bytes`].
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * size_of::<Node4>() + (self.block_first.len() + self.order.len()) * 4
+        self.nodes.len() * size_of::<WideNode>() + (self.block_first.len() + self.order.len()) * 4
     }
 
     /// Bytes of the triangle blocks (the vertices, unused lanes included).
@@ -274,7 +279,7 @@ impl WideBvh {
         let cost = |r: u32| if r & LEAF == 0 { 1.0 } else { (((r >> 28) & 7) + 1) as f64 };
         let mut total = cost(self.root) * root_area;
         for n in &self.nodes {
-            for l in 0..4 {
+            for l in 0..W {
                 if n.child[l] != EMPTY {
                     total += cost(n.child[l]) * area(n.child_box(l));
                 }
@@ -291,7 +296,7 @@ impl WideBvh {
         if self.root == EMPTY {
             return None;
         }
-        let rb = RayBox4::new(ray);
+        let rb = RayBoxW::new(ray);
         let tr = TriRay::new(ray);
         let mut t_max = t_max;
         let mut best = None;
@@ -303,9 +308,9 @@ impl WideBvh {
                 let node = &self.nodes[cur as usize];
                 let e = rb.entry(node, t_max);
                 // Hit children, then sorted farthest first: the nearest is visited now.
-                let mut c = [(0.0f32, 0u32); 4];
+                let mut c = [(0.0f32, 0u32); W];
                 let mut n = 0;
-                for l in 0..4 {
+                for l in 0..W {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
                         c[n] = (e[l], node.child[l]);
                         n += 1;
@@ -365,7 +370,7 @@ impl WideBvh {
         if self.root == EMPTY {
             return false;
         }
-        let rb = RayBox4::new(ray);
+        let rb = RayBoxW::new(ray);
         let tr = TriRay::new(ray);
         let mut stack = [0u32; STACK];
         stack[0] = self.root;
@@ -376,7 +381,7 @@ impl WideBvh {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
                 let e = rb.entry(node, t_max);
-                for l in 0..4 {
+                for l in 0..W {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
                         stack[sp] = node.child[l];
                         sp += 1;
@@ -428,30 +433,34 @@ impl Collapse<'_> {
             debug_assert!((1..=8).contains(&nb) && start < MAX_BLOCKS);
             return LEAF | (nb - 1) << 28 | start as u32;
         }
-        // Children in slot order: two, then grandchildren (see the module doc).
+        // Children in slot order: two, then grandchildren, then the children of the
+        // largest opening child until there are `W` (see the module doc).
         let kids2 = |j: usize| [j + 1, self.bin[j].offset as usize];
-        let [l, r] = kids2(i);
-        let mut kids: Vec<usize> = match (self.opens(l), self.opens(r)) {
-            (true, true) => [kids2(l), kids2(r)].concat(),
-            (true, false) => [&kids2(l)[..], &[r]].concat(),
-            (false, true) => [&[l][..], &kids2(r)].concat(),
-            (false, false) => vec![l, r],
-        };
-        if kids.len() == 3 {
-            let area = |j: usize| self.bin[j].aabb().surface_area();
-            let pick = (0..3).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
-            if let Some(k) = pick {
-                let [a, b] = kids2(kids[k]);
-                kids.splice(k..=k, [a, b]);
-            }
+        let mut kids = [0usize; W];
+        let mut n = 0;
+        for c in kids2(i) {
+            let add = if self.opens(c) { &kids2(c)[..] } else { &[c][..] };
+            kids[n..n + add.len()].copy_from_slice(add);
+            n += add.len();
         }
+        let area = |j: usize| self.bin[j].aabb().surface_area();
+        while n < W {
+            let pick = (0..n).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
+            let Some(k) = pick else { break };
+            let [a, b] = kids2(kids[k]);
+            kids.copy_within(k + 1..n, k + 2);
+            kids[k] = a;
+            kids[k + 1] = b;
+            n += 1;
+        }
+        let kids = &kids[..n];
         let me = self.out.nodes.len();
-        self.out.nodes.push(Node4::set_all(&[]));
-        let mut lanes = [(Aabb::EMPTY, EMPTY); 4];
+        self.out.nodes.push(WideNode::set_all(&[]));
+        let mut lanes = [(Aabb::EMPTY, EMPTY); W];
         for (lane, &k) in kids.iter().enumerate() {
             lanes[lane] = (self.bin[k].aabb(), self.subtree(k));
         }
-        self.out.nodes[me] = Node4::set_all(&lanes[..kids.len()]);
+        self.out.nodes[me] = WideNode::set_all(&lanes[..kids.len()]);
         me as u32
     }
 }
@@ -527,7 +536,7 @@ mod tests {
 
     /// The slab test on a true box, as the uncompressed nodes did it (the binary tree's
     /// test): entry distance or infinity.
-    fn entry_exact(rb: &RayBox4, b: &Aabb, t_max: f32) -> f32 {
+    fn entry_exact(rb: &RayBoxW, b: &Aabb, t_max: f32) -> f32 {
         let (mut t0, mut t1) = (0.0f32, t_max);
         for a in 0..3 {
             let (near, far) = if rb.neg[a] == 1 { (b.max[a], b.min[a]) } else { (b.min[a], b.max[a]) };
@@ -560,7 +569,7 @@ mod tests {
                     (b, k as u32)
                 })
                 .collect();
-            let node = Node4::set_all(&kids);
+            let node = WideNode::set_all(&kids);
             for (l, (b, _)) in kids.iter().enumerate() {
                 let g = node.child_box(l);
                 assert!(g.min.cmple(b.min).all() && g.max.cmpge(b.max).all(), "case {case} lane {l}: {g:?} {b:?}");
@@ -584,7 +593,7 @@ mod tests {
                     // Aimed at a child's centre: most of these enter.
                     d = (kids[i % n].0.centroid() - o).normalize_or(Vec3::Z);
                 }
-                let rb = RayBox4::new(&Ray::new(o, d));
+                let rb = RayBoxW::new(&Ray::new(o, d));
                 let t_max = if i % 2 == 0 { f32::INFINITY } else { uniform(&mut rng) * 3.0 * scale };
                 let e = rb.entry(&node, t_max);
                 for (l, (b, _)) in kids.iter().enumerate() {
@@ -681,7 +690,7 @@ mod tests {
         for (tris, (probe, t)) in [deep, same].into_iter().zip(probes) {
             let w = WideBvh::build(&tris);
             let lv = levels(&w, w.root);
-            assert!(lv >= 4 && 3 * lv < STACK, "{lv} levels");
+            assert!(lv >= 3 && (W - 1) * lv < STACK, "{lv} levels");
             for r in &nan {
                 assert!(w.intersect(r, f32::INFINITY).is_none() && !w.occluded(r, f32::INFINITY));
             }
