@@ -1,25 +1,22 @@
-//! The triangle BVH of meshes: 8-wide nodes of one 128-byte, cache-line-aligned block
-//! (the eight children's boxes quantised to 8 bits per plane on a power-of-two grid of
-//! the node, then the eight child references), leaves of [`Tri4`] blocks, closest-hit
-//! traversal that enters the nearest child first, and any-hit traversal for shadow rays.
-//! The quantised boxes contain the true ones, so the box test only becomes more
-//! conservative and the triangle test decides every hit as before.
+//! The triangle BVH of meshes: 4-wide nodes of one 128-byte, cache-line-aligned block
+//! (the four children's boxes as `[min/max][axis][lane]` arrays of `f32`, then the four
+//! child references), leaves of [`Tri4`] blocks, closest-hit traversal that enters the
+//! nearest child first, and any-hit traversal for shadow rays.
 //!
 //! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
-//! grandchildren (or, beside a leaf child, its other child's children), then keeps
-//! replacing its largest child (by area) that is not a leaf by that child's two children
-//! until it has eight; a subtree of at most four triangles becomes one leaf block. Leaves
-//! keep the binary tree's slot order, so the triangles' storage order (and `Hit::prim`)
-//! is the binary tree's; the tree is as deterministic as that build.
+//! grandchildren (or, beside a leaf child, its other child's children, then the children
+//! of the largest of those), and a subtree of at most four triangles becomes one leaf
+//! block. Leaves keep the binary tree's slot order, so the triangles' storage order (and
+//! `Hit::prim`) is the binary tree's; the tree is as deterministic as that build.
 //!
 //! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
 //! under 32 bytes per triangle, the vertices live in the blocks.
 //!
 //! Traversal stack: every node below the root sits at least two binary levels under its
 //! parent node, so a binary tree of depth below [`BINARY_DEPTH`] gives at most
-//! `BINARY_DEPTH / 2` node levels, and seven pending siblings per level fit [`STACK`].
+//! `BINARY_DEPTH / 2` node levels, and three pending siblings per level fit [`STACK`].
 
-// Lane loops `for l in 0..W` index several arrays by lane on purpose: that is the form the
+// Lane loops `for l in 0..4` index several arrays by lane on purpose: that is the form the
 // compiler vectorises.
 #![allow(clippy::needless_range_loop)]
 
@@ -30,12 +27,10 @@ use crate::geometry::{Aabb, Ray};
 use crate::shape::triangle::TriRay;
 use glam::Vec3;
 
-/// Children per node.
-const W: usize = 8;
 /// Depth limit of the binary tree that is collapsed (see the module doc).
 const BINARY_DEPTH: u32 = 42;
-/// Traversal stack entries: `W - 1` pending children per node level, plus one.
-const STACK: usize = (W - 1) * (BINARY_DEPTH as usize / 2) + 1;
+/// Traversal stack entries: three pending children per node level, plus one.
+const STACK: usize = 3 * (BINARY_DEPTH as usize / 2) + 1;
 /// Reference flag of a leaf; its bits 28-30 hold the block count minus one and bits
 /// 0-27 the first block.
 const LEAF: u32 = 1 << 31;
@@ -46,79 +41,34 @@ const EMPTY: u32 = u32::MAX;
 /// Most blocks a mesh can have (the rest of a reference's bits).
 pub(crate) const MAX_BLOCKS: usize = BLOCK_MASK as usize;
 
-/// Eight children in two 64-byte cache lines: their boxes quantised to 8 bits per plane on
-/// a grid of the node (`origin + q * scale` per axis, `scale` a power of two), as
-/// `q[0 = min, 1 = max][axis][lane]`, then their references (a node index, a leaf, or
-/// [`EMPTY`]). The grid boxes contain the true boxes (see [`WideNode::set_all`]), so the
-/// slab test on them only ever enters more boxes than on the true ones.
+/// Four children: boxes as `b[0 = min, 1 = max][axis][lane]`, then their references
+/// (a node index, a leaf, or [`EMPTY`] with an empty box).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-struct WideNode {
-    origin: [f32; 3],
-    scale: [f32; 3],
-    child: [u32; W],
-    q: [[[u8; W]; 3]; 2],
+struct Node4 {
+    b: [[[f32; 4]; 3]; 2],
+    child: [u32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<WideNode>() == 128 && std::mem::size_of::<Tri4>() == 144);
+const _: () = assert!(std::mem::size_of::<Node4>() == 128 && std::mem::size_of::<Tri4>() == 144);
 
-/// `2^e` for `e` in `[-149, 127]` (subnormal below -126).
-fn pow2(e: i32) -> f32 {
-    let e = e.clamp(-149, 127);
-    if e >= -126 { f32::from_bits(((e + 127) as u32) << 23) } else { f32::from_bits(1 << (e + 149)) }
-}
+impl Node4 {
+    const EMPTY: Node4 = Node4 { b: [[[f32::INFINITY; 4]; 3], [[f32::NEG_INFINITY; 4]; 3]], child: [EMPTY; 4] };
 
-/// The grid plane `q` of an axis, computed exactly as traversal computes it.
-#[inline(always)]
-fn plane(origin: f32, scale: f32, q: u8) -> f32 {
-    origin + f32::from(q) * scale
-}
-
-impl WideNode {
-    /// A node over `kids` (one to four children: true box and reference). The grid origin
-    /// is the union's minimum, the scale the smallest power of two whose 255 steps reach
-    /// its maximum; every child's planes are rounded outwards and then checked with the
-    /// traversal's own arithmetic, so the grid box contains the true box (if the true box
-    /// is finite; non-finite boxes do not occur, meshes reject such vertices).
-    fn set_all(kids: &[(Aabb, u32)]) -> WideNode {
-        let mut n = WideNode { origin: [0.0; 3], scale: [1.0; 3], child: [EMPTY; W], q: [[[255; W]; 3], [[0; W]; 3]] };
-        let all = kids.iter().fold(Aabb::EMPTY, |b, k| b.union(&k.0));
+    fn set(&mut self, lane: usize, bounds: Aabb, child: u32) {
         for a in 0..3 {
-            let (lo, hi) = (all.min[a], all.max[a]);
-            // Start one below the estimate (it may be a step too coarse), then coarsen
-            // until the top plane reaches `hi`; 2^127 * 255 is infinite, so this ends.
-            let est = ((hi - lo) / 255.0).log2().ceil();
-            let mut e = if est.is_finite() { est as i32 - 1 } else { -149 }.clamp(-149, 127);
-            while e < 127 && plane(lo, pow2(e), 255) < hi {
-                e += 1;
-            }
-            let s = pow2(e);
-            n.origin[a] = lo;
-            n.scale[a] = s;
-            for (l, (b, _)) in kids.iter().enumerate() {
-                // Saturating casts: NaN gives 0, out of range the nearest end.
-                let mut ql = ((b.min[a] - lo) / s).floor().clamp(0.0, 255.0) as u8;
-                while ql > 0 && plane(lo, s, ql) > b.min[a] {
-                    ql -= 1;
-                }
-                let mut qh = ((b.max[a] - lo) / s).ceil().clamp(0.0, 255.0) as u8;
-                while qh < 255 && plane(lo, s, qh) < b.max[a] {
-                    qh += 1;
-                }
-                n.q[0][a][l] = ql;
-                n.q[1][a][l] = qh;
-            }
+            self.b[0][a][lane] = bounds.min[a];
+            self.b[1][a][lane] = bounds.max[a];
         }
-        for (l, k) in kids.iter().enumerate() {
-            n.child[l] = k.1;
-        }
-        n
+        self.child[lane] = child;
     }
 
-    /// The grid box of child `lane` (it contains the child's true box).
     fn child_box(&self, lane: usize) -> Aabb {
-        let p = |m: usize, a: usize| plane(self.origin[a], self.scale[a], self.q[m][a][lane]);
-        Aabb { min: Vec3::new(p(0, 0), p(0, 1), p(0, 2)), max: Vec3::new(p(1, 0), p(1, 1), p(1, 2)) }
+        let b = &self.b;
+        Aabb {
+            min: Vec3::new(b[0][0][lane], b[0][1][lane], b[0][2][lane]),
+            max: Vec3::new(b[1][0][lane], b[1][1][lane], b[1][2][lane]),
+        }
     }
 }
 
@@ -138,7 +88,7 @@ pub struct TriangleHit {
 /// A 4-wide BVH that stores its triangles (see the module doc).
 #[derive(Clone, Debug)]
 pub struct WideBvh {
-    nodes: Vec<WideNode>,
+    nodes: Vec<Node4>,
     blocks: Vec<Tri4>,
     /// Slot of each block's lane 0; the other lanes follow.
     block_first: Vec<u32>,
@@ -149,41 +99,40 @@ pub struct WideBvh {
 }
 
 /// Per-ray data of the 4-wide slab test.
-struct RayBoxW {
+struct RayBox4 {
     o: [f32; 3],
     inv: [f32; 3],
     neg: [usize; 3],
 }
 
-impl RayBoxW {
+impl RayBox4 {
     #[inline(always)]
-    fn new(ray: &Ray) -> RayBoxW {
+    fn new(ray: &Ray) -> RayBox4 {
         // As in the binary tree: 1/±0 = ±inf, NaN slab values are ignored.
         let inv = (Vec3::ONE / ray.dir).to_array();
-        RayBoxW { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
+        RayBox4 { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
     }
 
     /// Entry distance into each child's box if the ray hits it with `t` in `[0, t_max]`,
     /// else infinity: the binary tree's slab test, lane by lane.
     #[inline(always)]
-    fn entry(&self, n: &WideNode, t_max: f32) -> [f32; W] {
-        let mut t0 = [0.0f32; W];
-        let mut t1 = [t_max; W];
+    fn entry(&self, n: &Node4, t_max: f32) -> [f32; 4] {
+        let mut t0 = [0.0f32; 4];
+        let mut t1 = [t_max; 4];
         for a in 0..3 {
-            let near = &n.q[self.neg[a]][a];
-            let far = &n.q[1 - self.neg[a]][a];
+            let near = &n.b[self.neg[a]][a];
+            let far = &n.b[1 - self.neg[a]][a];
             let (o, inv) = (self.o[a], self.inv[a]);
-            let (org, s) = (n.origin[a], n.scale[a]);
-            for l in 0..W {
-                let ta = (plane(org, s, near[l]) - o) * inv;
-                let tb = (plane(org, s, far[l]) - o) * inv * ROBUST;
+            for l in 0..4 {
+                let ta = (near[l] - o) * inv;
+                let tb = (far[l] - o) * inv * ROBUST;
                 // Written so that a NaN slab value leaves t0/t1 unchanged (maxps/minps).
                 t0[l] = if ta > t0[l] { ta } else { t0[l] };
                 t1[l] = if tb < t1[l] { tb } else { t1[l] };
             }
         }
-        let mut e = [f32::INFINITY; W];
-        for l in 0..W {
+        let mut e = [f32::INFINITY; 4];
+        for l in 0..4 {
             e[l] = if t0[l] <= t1[l] { t0[l] } else { f32::INFINITY };
         }
         e
@@ -254,7 +203,7 @@ impl WideBvh {
     /// Bytes of the nodes and the index data (each block's first slot, the slot order);
     /// the vertices are [`WideBvh::triangle_bytes`].
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * size_of::<WideNode>() + (self.block_first.len() + self.order.len()) * 4
+        self.nodes.len() * size_of::<Node4>() + (self.block_first.len() + self.order.len()) * 4
     }
 
     /// Bytes of the triangle blocks (the vertices, unused lanes included).
@@ -279,7 +228,7 @@ impl WideBvh {
         let cost = |r: u32| if r & LEAF == 0 { 1.0 } else { (((r >> 28) & 7) + 1) as f64 };
         let mut total = cost(self.root) * root_area;
         for n in &self.nodes {
-            for l in 0..W {
+            for l in 0..4 {
                 if n.child[l] != EMPTY {
                     total += cost(n.child[l]) * area(n.child_box(l));
                 }
@@ -296,7 +245,7 @@ impl WideBvh {
         if self.root == EMPTY {
             return None;
         }
-        let rb = RayBoxW::new(ray);
+        let rb = RayBox4::new(ray);
         let tr = TriRay::new(ray);
         let mut t_max = t_max;
         let mut best = None;
@@ -308,9 +257,9 @@ impl WideBvh {
                 let node = &self.nodes[cur as usize];
                 let e = rb.entry(node, t_max);
                 // Hit children, then sorted farthest first: the nearest is visited now.
-                let mut c = [(0.0f32, 0u32); W];
+                let mut c = [(0.0f32, 0u32); 4];
                 let mut n = 0;
-                for l in 0..W {
+                for l in 0..4 {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
                         c[n] = (e[l], node.child[l]);
                         n += 1;
@@ -370,7 +319,7 @@ impl WideBvh {
         if self.root == EMPTY {
             return false;
         }
-        let rb = RayBoxW::new(ray);
+        let rb = RayBox4::new(ray);
         let tr = TriRay::new(ray);
         let mut stack = [0u32; STACK];
         stack[0] = self.root;
@@ -381,7 +330,7 @@ impl WideBvh {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
                 let e = rb.entry(node, t_max);
-                for l in 0..W {
+                for l in 0..4 {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
                         stack[sp] = node.child[l];
                         sp += 1;
@@ -433,34 +382,29 @@ impl Collapse<'_> {
             debug_assert!((1..=8).contains(&nb) && start < MAX_BLOCKS);
             return LEAF | (nb - 1) << 28 | start as u32;
         }
-        // Children in slot order: two, then grandchildren, then the children of the
-        // largest opening child until there are `W` (see the module doc).
+        // Children in slot order: two, then grandchildren (see the module doc).
         let kids2 = |j: usize| [j + 1, self.bin[j].offset as usize];
-        let mut kids = [0usize; W];
-        let mut n = 0;
-        for c in kids2(i) {
-            let add = if self.opens(c) { &kids2(c)[..] } else { &[c][..] };
-            kids[n..n + add.len()].copy_from_slice(add);
-            n += add.len();
+        let [l, r] = kids2(i);
+        let mut kids: Vec<usize> = match (self.opens(l), self.opens(r)) {
+            (true, true) => [kids2(l), kids2(r)].concat(),
+            (true, false) => [&kids2(l)[..], &[r]].concat(),
+            (false, true) => [&[l][..], &kids2(r)].concat(),
+            (false, false) => vec![l, r],
+        };
+        if kids.len() == 3 {
+            let area = |j: usize| self.bin[j].aabb().surface_area();
+            let pick = (0..3).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
+            if let Some(k) = pick {
+                let [a, b] = kids2(kids[k]);
+                kids.splice(k..=k, [a, b]);
+            }
         }
-        let area = |j: usize| self.bin[j].aabb().surface_area();
-        while n < W {
-            let pick = (0..n).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
-            let Some(k) = pick else { break };
-            let [a, b] = kids2(kids[k]);
-            kids.copy_within(k + 1..n, k + 2);
-            kids[k] = a;
-            kids[k + 1] = b;
-            n += 1;
-        }
-        let kids = &kids[..n];
         let me = self.out.nodes.len();
-        self.out.nodes.push(WideNode::set_all(&[]));
-        let mut lanes = [(Aabb::EMPTY, EMPTY); W];
+        self.out.nodes.push(Node4::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
-            lanes[lane] = (self.bin[k].aabb(), self.subtree(k));
+            let r = self.subtree(k);
+            self.out.nodes[me].set(lane, self.bin[k].aabb(), r);
         }
-        self.out.nodes[me] = WideNode::set_all(&lanes[..kids.len()]);
         me as u32
     }
 }
@@ -532,80 +476,6 @@ mod tests {
             assert_eq!(w.occluded(&ray, t_max), want.is_some(), "ray {i}: occluded");
         }
         hits
-    }
-
-    /// The slab test on a true box, as the uncompressed nodes did it (the binary tree's
-    /// test): entry distance or infinity.
-    fn entry_exact(rb: &RayBoxW, b: &Aabb, t_max: f32) -> f32 {
-        let (mut t0, mut t1) = (0.0f32, t_max);
-        for a in 0..3 {
-            let (near, far) = if rb.neg[a] == 1 { (b.max[a], b.min[a]) } else { (b.min[a], b.max[a]) };
-            let ta = (near - rb.o[a]) * rb.inv[a];
-            let tb = (far - rb.o[a]) * rb.inv[a] * ROBUST;
-            t0 = if ta > t0 { ta } else { t0 };
-            t1 = if tb < t1 { tb } else { t1 };
-        }
-        if t0 <= t1 { t0 } else { f32::INFINITY }
-    }
-
-    #[test]
-    fn quantised_boxes_contain_the_true_boxes_and_lose_no_ray() {
-        let mut rng = Pcg32::new(77, 1);
-        let mut entered = 0;
-        for case in 0..4000 {
-            let scale = [1e-40f32, 1e-12, 1.0, 1e9, 1e30][case % 5];
-            // Far from the origin, the grid's planes round to the coordinates' ulp.
-            let offset = if case % 3 == 0 { Vec3::splat(1e6 * scale) } else { Vec3::ZERO };
-            let p = |rng: &mut Pcg32| (Vec3::new(uniform(rng), uniform(rng), uniform(rng)) * 2.0 - 1.0) * scale;
-            let n = 1 + case % 4;
-            let kids: Vec<(Aabb, u32)> = (0..n)
-                .map(|k| {
-                    let mut b = Aabb::new(offset + p(&mut rng), offset + p(&mut rng));
-                    match (case / 4 + k) % 7 {
-                        0 => b.max = b.min,        // a point
-                        1 => b.max.y = b.min.y,    // flat
-                        _ => {}
-                    }
-                    (b, k as u32)
-                })
-                .collect();
-            let node = WideNode::set_all(&kids);
-            for (l, (b, _)) in kids.iter().enumerate() {
-                let g = node.child_box(l);
-                assert!(g.min.cmple(b.min).all() && g.max.cmpge(b.max).all(), "case {case} lane {l}: {g:?} {b:?}");
-                if offset == Vec3::ZERO && scale >= 1e-12 {
-                    // Tight: within two grid steps of the true planes, steps at most twice
-                    // the union's extent / 255.
-                    let all = kids.iter().fold(Aabb::EMPTY, |u, k| u.union(&k.0));
-                    for a in 0..3 {
-                        let s = node.scale[a];
-                        assert!(s <= 2.0 * (all.max[a] - all.min[a]) / 255.0 * 1.001 || s <= f32::MIN_POSITIVE);
-                        assert!(b.min[a] - g.min[a] <= 2.0 * s && g.max[a] - b.max[a] <= 2.0 * s, "case {case}");
-                    }
-                }
-            }
-            for i in 0..20 {
-                let o = offset + p(&mut rng) * 2.0;
-                let mut d = random_dir(&mut rng);
-                if i % 5 == 0 {
-                    d = [Vec3::X, -Vec3::Y, Vec3::new(0.0, -0.0, 1.0)][i / 5 % 3];
-                } else if i % 2 == 1 {
-                    // Aimed at a child's centre: most of these enter.
-                    d = (kids[i % n].0.centroid() - o).normalize_or(Vec3::Z);
-                }
-                let rb = RayBoxW::new(&Ray::new(o, d));
-                let t_max = if i % 2 == 0 { f32::INFINITY } else { uniform(&mut rng) * 3.0 * scale };
-                let e = rb.entry(&node, t_max);
-                for (l, (b, _)) in kids.iter().enumerate() {
-                    let want = entry_exact(&rb, b, t_max);
-                    if want < f32::INFINITY {
-                        entered += 1;
-                        assert!(e[l] <= want, "case {case} ray {i} lane {l}: {} > {want}", e[l]);
-                    }
-                }
-            }
-        }
-        assert!(entered > 10_000, "{entered}");
     }
 
     #[test]
@@ -690,7 +560,7 @@ mod tests {
         for (tris, (probe, t)) in [deep, same].into_iter().zip(probes) {
             let w = WideBvh::build(&tris);
             let lv = levels(&w, w.root);
-            assert!(lv >= 3 && (W - 1) * lv < STACK, "{lv} levels");
+            assert!(lv >= 4 && 3 * lv < STACK, "{lv} levels");
             for r in &nan {
                 assert!(w.intersect(r, f32::INFINITY).is_none() && !w.occluded(r, f32::INFINITY));
             }
