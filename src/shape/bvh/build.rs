@@ -102,7 +102,11 @@ impl BuildPrim {
 /// Builds the tree over `n` primitives whose boxes `prim_bounds(i)` gives: the nodes
 /// (depth first, root first) and the slot order (slot `k` of a leaf holds primitive
 /// `order[k]` of the input).
-pub(super) fn build_tree(n: usize, prim_bounds: impl Fn(usize) -> Aabb + Sync, limits: Limits) -> (Vec<Node>, Vec<u32>) {
+pub(super) fn build_tree(
+    n: usize,
+    prim_bounds: impl Fn(usize) -> Aabb + Sync,
+    limits: Limits,
+) -> (Vec<Node>, Vec<u32>) {
     let prim = |i: usize| BuildPrim::new(prim_bounds(i), i as u32);
     let mut prims: Vec<BuildPrim> =
         if n > limits.threshold { (0..n).into_par_iter().map(prim).collect() } else { (0..n).map(prim).collect() };
