@@ -539,7 +539,17 @@ mod tests {
             );
         }
         let serial = WideBvh::build_with_threshold(&v, usize::MAX);
-        assert_eq!((serial.nodes, serial.blocks, serial.root), (reference.nodes, reference.blocks, reference.root));
+        assert_eq!((&serial.nodes, &serial.blocks, serial.root), (&reference.nodes, &reference.blocks, reference.root));
+        // The default thresholds and the indexed input (vertices shared between
+        // triangles, as a mesh gives them) build the same tree too.
+        let positions: Vec<Vec3> = v.iter().flatten().copied().collect();
+        let indexed: Vec<[u32; 3]> = (0..v.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        for t in [WideBvh::build(&v), WideBvh::build_indexed(&positions, &indexed)] {
+            assert_eq!(
+                (t.nodes, t.blocks, t.order),
+                (serial.nodes.clone(), serial.blocks.clone(), serial.order.clone())
+            );
+        }
     }
 
     #[test]
