@@ -67,7 +67,9 @@ impl Box3A {
 }
 
 /// A primitive during the build, in 32 bytes: its box's corners as SSE registers, the
-/// index in the input slice kept (as bits) in the minimum's unused fourth lane.
+/// index in the input slice kept in the minimum's unused fourth lane as the bits of a
+/// float in `[2, 2^33)`: the SIMD arithmetic on boxes computes that lane too, and a
+/// denormal there (the index's bits alone) costs a microcode assist per operation.
 #[derive(Clone, Copy, Debug)]
 struct BuildPrim {
     min: Vec4,
@@ -76,9 +78,13 @@ struct BuildPrim {
 
 const _: () = assert!(std::mem::size_of::<BuildPrim>() == 32);
 
+/// Set in a [`BuildPrim`]'s index lane (bit 30: the float's exponent is at least 128).
+const INDEX_BIT: u32 = 1 << 30;
+
 impl BuildPrim {
     fn new(b: Aabb, index: u32) -> BuildPrim {
-        BuildPrim { min: b.min.extend(f32::from_bits(index)), max: b.max.extend(0.0) }
+        debug_assert!(index < INDEX_BIT);
+        BuildPrim { min: b.min.extend(f32::from_bits(INDEX_BIT | index)), max: b.max.extend(0.0) }
     }
 
     #[inline(always)]
@@ -88,7 +94,7 @@ impl BuildPrim {
 
     #[inline(always)]
     fn index(&self) -> u32 {
-        self.min.w.to_bits()
+        self.min.w.to_bits() & !INDEX_BIT
     }
 
     /// `(min + max) * 0.5`, as [`Aabb::centroid`].
@@ -107,6 +113,7 @@ pub(super) fn build_tree(
     prim_bounds: impl Fn(usize) -> Aabb + Sync,
     limits: Limits,
 ) -> (Vec<Node>, Vec<u32>) {
+    assert!(n < INDEX_BIT as usize, "{n} primitives: at most 2^30 - 1 are supported");
     let prim = |i: usize| BuildPrim::new(prim_bounds(i), i as u32);
     let mut prims: Vec<BuildPrim> =
         if n > limits.threshold { (0..n).into_par_iter().map(prim).collect() } else { (0..n).map(prim).collect() };
