@@ -165,9 +165,7 @@ impl Mesh {
         if kept.len() > MAX_BLOCKS {
             return Err(err(format!("{} triangles: at most {MAX_BLOCKS} are supported", kept.len())));
         }
-        let tris: Vec<[Vec3; 3]> = kept.iter().map(|t| t.map(|i| positions[i as usize])).collect();
-        let bvh = WideBvh::build(&tris);
-        drop(tris);
+        let bvh = WideBvh::build_indexed(&positions, &kept);
         let order = bvh.prim_order();
         let normal_idx = if normals.is_some() { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
         Ok(Mesh { normal_idx, normals, bvh, dropped })

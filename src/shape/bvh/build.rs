@@ -3,7 +3,8 @@
 //! traversal code because both trees start from it (the wide tree collapses it).
 //!
 //! Determinism: the tree depends only on the input boxes, never on the thread count.
-//! Subtrees are built in parallel with `rayon::join` and appended in a fixed order; the
+//! Subtrees are built in parallel with `rayon::join` (at every level down to
+//! [`super::JOIN_THRESHOLD`] primitives) and appended in a fixed order; the
 //! bins of large nodes are filled in parallel over fixed chunks and merged in chunk
 //! order, and a bin holds only minima, maxima and counts, which are exact whatever the
 //! order of the merge.
@@ -13,7 +14,7 @@
 
 use super::Node;
 use crate::geometry::Aabb;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 use rayon::prelude::*;
 
 /// Number of SAH bins per axis.
@@ -30,8 +31,10 @@ const BIN_CHUNK: usize = 32 * 1024;
 /// Knobs of one build.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Limits {
-    /// Node sizes above which the children (and the bins) are built in parallel.
+    /// Node sizes above which the bins and bounds are filled in parallel.
     pub threshold: usize,
+    /// Node sizes above which the two children are built in parallel (`rayon::join`).
+    pub join: usize,
     /// The tree's depth stays below this (levels of nodes, the root is level 0): nodes
     /// that the SAH would take deeper are split at the median instead.
     pub max_depth: u32,
@@ -63,37 +66,65 @@ impl Box3A {
     }
 }
 
-/// A primitive during the build: its box and its index in the input slice.
+/// A primitive during the build, in 32 bytes: its box's corners as SSE registers, the
+/// index in the input slice kept in the minimum's unused fourth lane as the bits of a
+/// float in `[2, 2^33)`: the SIMD arithmetic on boxes computes that lane too, and a
+/// denormal there (the index's bits alone) costs a microcode assist per operation.
 #[derive(Clone, Copy, Debug)]
 struct BuildPrim {
-    bounds: Box3A,
-    index: u32,
+    min: Vec4,
+    max: Vec4,
 }
 
+const _: () = assert!(std::mem::size_of::<BuildPrim>() == 32);
+
+/// Set in a [`BuildPrim`]'s index lane (bit 30: the float's exponent is at least 128).
+const INDEX_BIT: u32 = 1 << 30;
+
 impl BuildPrim {
+    fn new(b: Aabb, index: u32) -> BuildPrim {
+        debug_assert!(index < INDEX_BIT);
+        BuildPrim { min: b.min.extend(f32::from_bits(INDEX_BIT | index)), max: b.max.extend(0.0) }
+    }
+
+    #[inline(always)]
+    fn bounds(&self) -> Box3A {
+        Box3A { min: Vec3A::from_vec4(self.min), max: Vec3A::from_vec4(self.max) }
+    }
+
+    #[inline(always)]
+    fn index(&self) -> u32 {
+        self.min.w.to_bits() & !INDEX_BIT
+    }
+
     /// `(min + max) * 0.5`, as [`Aabb::centroid`].
     #[inline(always)]
     fn centroid(&self) -> Vec3A {
-        (self.bounds.min + self.bounds.max) * 0.5
+        let b = self.bounds();
+        (b.min + b.max) * 0.5
     }
 }
 
 /// Builds the tree over `n` primitives whose boxes `prim_bounds(i)` gives: the nodes
 /// (depth first, root first) and the slot order (slot `k` of a leaf holds primitive
 /// `order[k]` of the input).
-pub(super) fn build_tree(n: usize, prim_bounds: impl Fn(usize) -> Aabb, limits: Limits) -> (Vec<Node>, Vec<u32>) {
-    let mut prims: Vec<BuildPrim> = (0..n)
-        .map(|i| {
-            let b = prim_bounds(i);
-            BuildPrim { bounds: Box3A { min: b.min.into(), max: b.max.into() }, index: i as u32 }
-        })
-        .collect();
+pub(super) fn build_tree(
+    n: usize,
+    prim_bounds: impl Fn(usize) -> Aabb + Sync,
+    limits: Limits,
+) -> (Vec<Node>, Vec<u32>) {
+    assert!(n < INDEX_BIT as usize, "{n} primitives: at most 2^30 - 1 are supported");
+    let prim = |i: usize| BuildPrim::new(prim_bounds(i), i as u32);
+    let mut prims: Vec<BuildPrim> =
+        if n > limits.threshold { (0..n).into_par_iter().map(prim).collect() } else { (0..n).map(prim).collect() };
     let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
     if !prims.is_empty() {
         build_node(&mut prims, 0, 0, &mut nodes, limits);
     }
     nodes.shrink_to_fit();
-    (nodes, prims.iter().map(|p| p.index).collect())
+    let order = prims.iter().map(|p| p.index()).collect();
+    drop(prims);
+    (nodes, order)
 }
 
 /// Smallest `k` with `2^k >= n`.
@@ -126,7 +157,7 @@ fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3, scale: [f32; 3]) {
         for a in 0..3 {
             let b = &mut bins[a][bin_of(c[a], lo[a], scale[a])];
             b.count += 1;
-            b.bounds = b.bounds.union(p.bounds);
+            b.bounds = b.bounds.union(p.bounds());
         }
     }
 }
@@ -134,7 +165,7 @@ fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3, scale: [f32; 3]) {
 /// Bounds and centroid bounds of `prims` (in parallel over fixed chunks when large).
 fn node_bounds(prims: &[BuildPrim], threshold: usize) -> (Aabb, Aabb) {
     let one = |ps: &[BuildPrim]| {
-        ps.iter().fold((Box3A::EMPTY, Box3A::EMPTY), |(b, c), p| (b.union(p.bounds), c.grow(p.centroid())))
+        ps.iter().fold((Box3A::EMPTY, Box3A::EMPTY), |(b, c), p| (b.union(p.bounds()), c.grow(p.centroid())))
     };
     let (b, c) = if prims.len() > threshold {
         let parts: Vec<(Box3A, Box3A)> = prims.par_chunks(BIN_CHUNK).map(one).collect();
@@ -250,26 +281,23 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
             };
             let mid = n / 2;
             prims.select_nth_unstable_by(mid, |p, q| {
-                p.centroid()[a].total_cmp(&q.centroid()[a]).then(p.index.cmp(&q.index))
+                p.centroid()[a].total_cmp(&q.centroid()[a]).then(p.index().cmp(&q.index()))
             });
             (mid, a)
         }
     };
     let (left, right) = prims.split_at_mut(mid);
-    let second = if n > limits.threshold {
-        let (ln, rn) = rayon::join(
+    let second = if n > limits.join {
+        // The left subtree goes straight into `nodes` (it comes first depth-first), the
+        // right one into its own vector, appended after: one copy of half the nodes.
+        let ((), rn) = rayon::join(
+            || build_node(left, first, depth + 1, nodes, limits),
             || {
-                let mut v = Vec::new();
-                build_node(left, first, depth + 1, &mut v, limits);
-                v
-            },
-            || {
-                let mut v = Vec::new();
+                let mut v = Vec::with_capacity(right.len() * 2 / 3 + 1);
                 build_node(right, first + mid as u32, depth + 1, &mut v, limits);
                 v
             },
         );
-        append(nodes, ln);
         let second = nodes.len();
         append(nodes, rn);
         second

@@ -27,8 +27,12 @@ pub use wide::{TriangleHit, WideBvh};
 
 use build::{Limits, build_tree};
 
-/// Node sizes above which the two children are built in parallel.
+/// Node sizes above which the bins and bounds of a node are filled in parallel.
 const PARALLEL_THRESHOLD: usize = 64 * 1024;
+/// Node sizes above which the two children are built in parallel (`rayon::join`):
+/// small enough that every level of a large tree is parallel, large enough that a task
+/// (about a millisecond) dwarfs rayon's overhead.
+const JOIN_THRESHOLD: usize = 4096;
 /// Traversal stack depth; the build keeps the tree shallower than this.
 const STACK: usize = 64;
 /// Traversal cost of [`Bvh::sah_cost`], the usual 1 so that reports stay comparable.
@@ -130,15 +134,23 @@ impl RayBox {
 impl Bvh {
     /// Builds over primitive bounding boxes (binned SAH with 16 bins per axis on the
     /// centroid bounds, all three axes tried; leaves of at most 8 primitives when the
-    /// SAH prefers them; children built in parallel with `rayon::join` above 64k
-    /// primitives). Deterministic: the same tree whatever the thread count.
+    /// SAH prefers them; children built in parallel with `rayon::join` above 4k
+    /// primitives, bins filled in parallel above 64k). Deterministic: the same tree
+    /// whatever the thread count.
     pub fn build(prim_bounds: &[Aabb]) -> Bvh {
-        Self::build_with_threshold(prim_bounds, PARALLEL_THRESHOLD)
+        Self::build_with(prim_bounds, PARALLEL_THRESHOLD, JOIN_THRESHOLD)
     }
 
+    /// With both thresholds equal (tests: small to be parallel everywhere, `usize::MAX`
+    /// for a serial build).
+    #[cfg(test)]
     fn build_with_threshold(prim_bounds: &[Aabb], threshold: usize) -> Bvh {
+        Self::build_with(prim_bounds, threshold, threshold)
+    }
+
+    fn build_with(prim_bounds: &[Aabb], threshold: usize, join: usize) -> Bvh {
         let (nodes, order) =
-            build_tree(prim_bounds.len(), |i| prim_bounds[i], Limits { threshold, max_depth: STACK as u32 });
+            build_tree(prim_bounds.len(), |i| prim_bounds[i], Limits { threshold, join, max_depth: STACK as u32 });
         Bvh { nodes, order }
     }
 

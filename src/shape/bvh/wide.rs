@@ -22,7 +22,7 @@
 
 use super::build::{Limits, build_tree};
 use super::tri4::Tri4;
-use super::{Node, PARALLEL_THRESHOLD, ROBUST};
+use super::{JOIN_THRESHOLD, Node, PARALLEL_THRESHOLD, ROBUST};
 use crate::geometry::{Aabb, Ray};
 use crate::shape::triangle::TriRay;
 use glam::Vec3;
@@ -140,16 +140,36 @@ impl RayBox4 {
 }
 
 impl WideBvh {
-    /// Builds over triangles given by their vertices (binned SAH on their boxes, in
-    /// parallel above 64k triangles, then collapsed). At most 2^28 - 1 blocks (meshes
+    /// Builds over triangles given by their vertices (binned SAH on their boxes, subtrees
+    /// in parallel above 4k triangles, then collapsed). At most 2^28 - 1 blocks (meshes
     /// check this when they load).
     pub fn build(tris: &[[Vec3; 3]]) -> WideBvh {
-        Self::build_with_threshold(tris, PARALLEL_THRESHOLD)
+        Self::build_with(tris.len(), |i| tris[i], PARALLEL_THRESHOLD, JOIN_THRESHOLD)
     }
 
+    /// [`WideBvh::build`] over indexed triangles (`tris[i]` holds three indices into
+    /// `positions`, all in range), without an array of their vertices.
+    pub fn build_indexed(positions: &[Vec3], tris: &[[u32; 3]]) -> WideBvh {
+        Self::build_with(tris.len(), |i| tris[i].map(|v| positions[v as usize]), PARALLEL_THRESHOLD, JOIN_THRESHOLD)
+    }
+
+    /// With both thresholds equal (tests: small to be parallel everywhere, `usize::MAX`
+    /// for a serial build).
+    #[cfg(test)]
     fn build_with_threshold(tris: &[[Vec3; 3]], threshold: usize) -> WideBvh {
-        let limits = Limits { threshold, max_depth: BINARY_DEPTH };
-        let (bin, order) = build_tree(tris.len(), |i| Aabb::new(tris[i][0], tris[i][1]).grow(tris[i][2]), limits);
+        Self::build_with(tris.len(), |i| tris[i], threshold, threshold)
+    }
+
+    fn build_with(n: usize, tri: impl Fn(usize) -> [Vec3; 3] + Sync, threshold: usize, join: usize) -> WideBvh {
+        let limits = Limits { threshold, join, max_depth: BINARY_DEPTH };
+        let (bin, order) = build_tree(
+            n,
+            |i| {
+                let t = tri(i);
+                Aabb::new(t[0], t[1]).grow(t[2])
+            },
+            limits,
+        );
         // Slot range (first, count) of every binary subtree; children follow their parent.
         let mut range = vec![(0u32, 0u32); bin.len()];
         for i in (0..bin.len()).rev() {
@@ -161,15 +181,15 @@ impl WideBvh {
             };
         }
         let mut w = WideBvh {
-            nodes: Vec::with_capacity(tris.len() / 6 + 1),
-            blocks: Vec::with_capacity(tris.len() / 2 + 1),
-            block_first: Vec::with_capacity(tris.len() / 2 + 1),
+            nodes: Vec::with_capacity(n / 6 + 1),
+            blocks: Vec::with_capacity(n / 2 + 1),
+            block_first: Vec::with_capacity(n / 2 + 1),
             order: Vec::new(),
             root: EMPTY,
             bounds: bin.first().map_or(Aabb::EMPTY, |n| n.aabb()),
         };
         if !bin.is_empty() {
-            let mut c = Collapse { bin: &bin, range: &range, tris, order: &order, out: &mut w };
+            let mut c = Collapse { bin: &bin, range: &range, tri: &tri, order: &order, out: &mut w };
             w.root = c.subtree(0);
         }
         w.order = order;
@@ -350,15 +370,16 @@ impl WideBvh {
 }
 
 /// State of the collapse of a binary tree into [`WideBvh`] nodes.
-struct Collapse<'a> {
+struct Collapse<'a, F> {
     bin: &'a [Node],
     range: &'a [(u32, u32)],
-    tris: &'a [[Vec3; 3]],
+    /// The vertices of input triangle `i`.
+    tri: &'a F,
     order: &'a [u32],
     out: &'a mut WideBvh,
 }
 
-impl Collapse<'_> {
+impl<F: Fn(usize) -> [Vec3; 3]> Collapse<'_, F> {
     /// True if binary node `i` becomes a 4-wide node (not a leaf).
     fn opens(&self, i: usize) -> bool {
         self.bin[i].count == 0 && self.range[i].1 > 4
@@ -373,7 +394,7 @@ impl Collapse<'_> {
                 let n = (first + count - j).min(4) as usize;
                 let mut lanes = [[Vec3::ZERO; 3]; 4];
                 for (k, lane) in lanes[..n].iter_mut().enumerate() {
-                    *lane = self.tris[self.order[j as usize + k] as usize];
+                    *lane = (self.tri)(self.order[j as usize + k] as usize);
                 }
                 self.out.blocks.push(Tri4::new(&lanes[..n]));
                 self.out.block_first.push(j);
@@ -518,7 +539,17 @@ mod tests {
             );
         }
         let serial = WideBvh::build_with_threshold(&v, usize::MAX);
-        assert_eq!((serial.nodes, serial.blocks, serial.root), (reference.nodes, reference.blocks, reference.root));
+        assert_eq!((&serial.nodes, &serial.blocks, serial.root), (&reference.nodes, &reference.blocks, reference.root));
+        // The default thresholds and the indexed input (vertices shared between
+        // triangles, as a mesh gives them) build the same tree too.
+        let positions: Vec<Vec3> = v.iter().flatten().copied().collect();
+        let indexed: Vec<[u32; 3]> = (0..v.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        for t in [WideBvh::build(&v), WideBvh::build_indexed(&positions, &indexed)] {
+            assert_eq!(
+                (t.nodes, t.blocks, t.order),
+                (serial.nodes.clone(), serial.blocks.clone(), serial.order.clone())
+            );
+        }
     }
 
     #[test]
