@@ -19,8 +19,12 @@ pub struct Quad {
     n: Vec3,
     /// `n · origin`: the plane offset.
     d: f32,
-    /// `(u × v) / |u × v|²`: projects a point to the quad coordinates.
-    w: Vec3,
+    /// `v × w` and `w × u` with `w = (u × v) / |u × v|²`: a point `q` relative
+    /// to the origin has quad coordinates `(q · pu, q · pv)` (the triple
+    /// products `w · (q × v)` and `w · (u × q)` with the cross products
+    /// taken once, here, instead of per ray).
+    pu: Vec3,
+    pv: Vec3,
 }
 
 impl Quad {
@@ -30,7 +34,7 @@ impl Quad {
         let c = edge_u.cross(edge_v);
         let len2 = c.length_squared();
         let (n, w) = if len2 > 0.0 { (c / len2.sqrt(), c / len2) } else { (Vec3::ZERO, Vec3::ZERO) };
-        Quad { origin, edge_u, edge_v, n, d: n.dot(origin), w }
+        Quad { origin, edge_u, edge_v, n, d: n.dot(origin), pu: edge_v.cross(w), pv: w.cross(edge_u) }
     }
 
     /// Unit normal `normalize(edge_u x edge_v)`.
@@ -49,8 +53,7 @@ impl Quad {
     fn hit_coords(&self, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32, Vec3)> {
         let t = plane_t(self.n, self.d, ray, t_max)?;
         let q = ray.at(t) - self.origin;
-        let a = self.w.dot(q.cross(self.edge_v));
-        let b = self.w.dot(self.edge_u.cross(q));
+        let (a, b) = (q.dot(self.pu), q.dot(self.pv));
         ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some((t, a, b, self.n))
     }
 
