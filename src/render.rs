@@ -217,12 +217,13 @@ fn render_tile<E: Estimator, O: Contribution>(
     pass: u32,
 ) -> TileSamples<O> {
     let (seed, kind) = (scene.settings.seed, scene.settings.sampler);
+    let pixels = width as u64 * scene.settings.height as u64;
     let mut out = Vec::with_capacity(tile.len());
     let mut splats = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             let pixel = y as u64 * width as u64 + x as u64;
-            let mut sampler = Sampler::of_kind(kind, seed, pixel, pass as u64);
+            let mut sampler = Sampler::of_kind(kind, seed, pixel, pass as u64, pixels);
             let jitter = sampler.get_2d(Dim::FILM);
             let film_pos = Vec2::new(x as f32, y as f32) + jitter;
             out.push(estimator.sample(scene, film_pos, &mut sampler, &mut splats));

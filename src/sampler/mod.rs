@@ -16,6 +16,8 @@
 //! - **`sobol`**: Owen-scrambled, shuffled Sobol points ([`sobol`]), index `k`,
 //!   one padded 1D or 2D point set per [`Dim`], seeded by `(seed, p, dim)`.
 //!   Stratified over the samples of a pixel in every draw; any spp works.
+//!   BDPT's light subpath draws from one sequence over the whole film instead,
+//!   index `pass · pixels + pixel` (its splats land anywhere: see [`Sobol`]).
 //!
 //! # The dimension layout
 //! Integrators ask for numbers by purpose and bounce, never in stream order,
@@ -145,6 +147,12 @@ impl Dim {
         if light { self.on_light_path() } else { self }
     }
 
+    /// True for the draws of BDPT's light subpath (its start and its bounces).
+    #[inline]
+    pub fn is_light_path(self) -> bool {
+        self.0 & LIGHT_PATH != 0 || matches!(self, Dim::EMIT_CHOICE | Dim::EMIT_POSITION | Dim::EMIT_DIRECTION)
+    }
+
     /// True when the `sobol` sampler has a point set for this draw.
     #[inline]
     fn on_table(self) -> bool {
@@ -162,12 +170,31 @@ pub enum Sampler {
 }
 
 /// The `sobol` sampler's state: its key (a hash of seed and pixel) and the sample index.
+///
+/// BDPT's light subpaths draw from one point set for the whole film instead
+/// ([`Dim::is_light_path`]): key a hash of the seed alone, index
+/// `pass · pixels + pixel`. A light subpath's splats land anywhere, so what
+/// matters for them is how the light subpaths of a pass spread over the light
+/// and its directions together, not per pixel: with a power-of-two pixel
+/// count each pass's light subpaths are a stratified set in every light draw.
+/// Past 2^32 light subpaths the index wraps and the key changes (a fresh
+/// scramble), so no subpath's numbers repeat.
+/// Each sample's numbers stay uniform and independent across draws (each
+/// draw's set is scrambled with its own hash), so every estimate stays
+/// unbiased, and the index is still a function of `(pixel, pass)`, so merge
+/// and resume stay exact.
 #[derive(Clone, Copy, Debug)]
 pub struct Sobol {
     key: u64,
     index: u32,
     /// `index` with its bits reversed (every draw starts from it).
     index_reversed: u32,
+    /// The key of the light subpath's draws (a hash of the seed).
+    light_key: u64,
+    /// The light subpath's index, `pass · pixels + pixel`.
+    light_index: u32,
+    /// `light_index` with its bits reversed.
+    light_index_reversed: u32,
 }
 
 /// SplitMix64's finaliser: a bijective 64-bit mix (Steele et al. 2014).
@@ -195,17 +222,30 @@ impl Sampler {
         Sampler::Independent(Pcg32::new(state, stream))
     }
 
-    /// The sampler `kind` for sample `pass` of pixel `pixel` (row-major index) for `seed`.
-    /// The `sobol` sampler's index is the pass (modulo 2^32).
+    /// The sampler `kind` for sample `pass` of pixel `pixel` (row-major index) of a film
+    /// of `pixels` pixels, for `seed`. The `sobol` sampler's index is the pass (modulo
+    /// 2^32); on BDPT's light subpath it is `pass · pixels + pixel` (see [`Sobol`]).
     #[inline]
-    pub fn of_kind(kind: SamplerKind, seed: u64, pixel: u64, pass: u64) -> Self {
+    pub fn of_kind(kind: SamplerKind, seed: u64, pixel: u64, pass: u64, pixels: u64) -> Self {
         match kind {
             SamplerKind::Independent => Sampler::new(seed, pixel, pass),
             SamplerKind::Sobol => {
                 let a = mix64(seed ^ 0x2545_f491_4f6c_dd1d);
                 let key = mix64(a ^ pixel.wrapping_mul(0x9e37_79b9_7f4a_7c15));
                 let index = pass as u32;
-                Sampler::Sobol(Sobol { key, index, index_reversed: index.reverse_bits() })
+                // The film's sequence index; every 2^32 of them (e.g. past 512
+                // passes of a 4096x2048 film) take a fresh scramble, so no index repeats.
+                let global = pass.wrapping_mul(pixels).wrapping_add(pixel);
+                let light_key = mix64(a ^ 0x6a09_e667_f3bc_c909 ^ (global >> 32).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+                let light_index = global as u32;
+                Sampler::Sobol(Sobol {
+                    key,
+                    index,
+                    index_reversed: index.reverse_bits(),
+                    light_key,
+                    light_index,
+                    light_index_reversed: light_index.reverse_bits(),
+                })
             }
         }
     }
@@ -248,37 +288,43 @@ impl Sampler {
 }
 
 impl Sobol {
-    /// The hash that seeds draw `dim` in this pixel.
+    /// The hash that seeds draw `dim`, its sample index and that index reversed:
+    /// this pixel's, or the film's for a light subpath's draw.
     #[inline]
-    fn seed_of(&self, dim: Dim) -> u64 {
-        mix64(self.key ^ dim.0.wrapping_mul(0xd6e8_feb8_6659_fd93))
+    fn draw(&self, dim: Dim) -> (u64, u32, u32) {
+        let (key, index, reversed) = if dim.is_light_path() {
+            (self.light_key, self.light_index, self.light_index_reversed)
+        } else {
+            (self.key, self.index, self.index_reversed)
+        };
+        (mix64(key ^ dim.0.wrapping_mul(0xd6e8_feb8_6659_fd93)), index, reversed)
     }
 
     /// Off the table: a hash of (key, dim, index).
     #[inline]
-    fn fallback(&self, h: u64) -> u64 {
-        mix64(h ^ (self.index as u64 + 1).wrapping_mul(0x8cb9_2ba7_2f3d_8dd7))
+    fn fallback(h: u64, index: u32) -> u64 {
+        mix64(h ^ (index as u64 + 1).wrapping_mul(0x8cb9_2ba7_2f3d_8dd7))
     }
 
     #[inline]
     fn get_1d(&self, dim: Dim) -> f32 {
-        let h = self.seed_of(dim);
+        let (h, index, reversed) = self.draw(dim);
         if !dim.on_table() {
-            return unit_24(self.fallback(h));
+            return unit_24(Sobol::fallback(h, index));
         }
-        sobol::to_unit(sobol::point_1d(self.index_reversed, h))
+        sobol::to_unit(sobol::point_1d(reversed, h))
     }
 
     #[inline]
     fn get_2d(&self, dim: Dim) -> Vec2 {
-        let h = self.seed_of(dim);
+        let (h, index, reversed) = self.draw(dim);
         if !dim.on_table() {
-            let r = self.fallback(h);
+            let r = Sobol::fallback(h, index);
             return Vec2::new(unit_24(r), unit_24(r << 24));
         }
         // The second coordinate's seed: 32 more bits from the hash (a multiply spreads them).
         let h2 = ((h ^ (h >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9) >> 32) as u32;
-        let (x, y) = sobol::point_2d(self.index_reversed, h, h2);
+        let (x, y) = sobol::point_2d(reversed, h, h2);
         Vec2::new(sobol::to_unit(x), sobol::to_unit(y))
     }
 }

@@ -4,11 +4,11 @@
 use super::*;
 
 fn draw_1d(kind: SamplerKind, seed: u64, pixel: u64, pass: u64, dim: Dim) -> f32 {
-    Sampler::of_kind(kind, seed, pixel, pass).get_1d(dim)
+    Sampler::of_kind(kind, seed, pixel, pass, 1).get_1d(dim)
 }
 
 fn draw_2d(kind: SamplerKind, seed: u64, pixel: u64, pass: u64, dim: Dim) -> Vec2 {
-    Sampler::of_kind(kind, seed, pixel, pass).get_2d(dim)
+    Sampler::of_kind(kind, seed, pixel, pass, 1).get_2d(dim)
 }
 
 #[test]
@@ -42,7 +42,7 @@ fn independent_is_the_old_stream_and_ignores_the_layout() {
         Pcg32::new(state, mix64(state ^ 0x5851_f42d_4c95_7f2d))
     };
     let mut rng = old_stream(5, 6, 7);
-    let mut a = Sampler::of_kind(SamplerKind::Independent, 5, 6, 7);
+    let mut a = Sampler::of_kind(SamplerKind::Independent, 5, 6, 7, 1);
     for k in 0..16u32 {
         let x = if k % 3 == 0 { a.get_1d(Dim::roulette(k)) } else { a.get_2d(Dim::bsdf(40 - k)).y };
         if k % 3 != 0 {
@@ -85,13 +85,13 @@ fn cell_counts(points: &[Vec2], a: u32, b: u32) -> Vec<u32> {
 
 /// The (0,m,2)-net property, against its definition: the first `2^m` samples of a pixel
 /// put exactly one point in every elementary interval of area `2^-m` (every shape
-/// `2^-a × 2^-(m-a)`), for the film draw (Sobol dimensions 0 and 1 themselves), padded
-/// pairs of the camera and the light subpath, several m, seeds and pixels; 1D draws put one
-/// point in every interval of length `2^-m`. A sample count that is a power of two times
-/// an aligned block (samples `2^m .. 2^(m+1)`) is a net too (what `--passes` renders).
+/// `2^-a × 2^-(m-a)`), for the film draw (Sobol dimensions 0 and 1 themselves) and padded
+/// pairs of the camera path, several m, seeds and pixels; 1D draws put one point in every
+/// interval of length `2^-m`. A sample count that is a power of two times an aligned block
+/// (samples `2^m .. 2^(m+1)`) is a net too (what `--passes` renders).
 #[test]
 fn sobol_draws_are_nets_in_every_elementary_interval() {
-    for dim in [Dim::FILM, Dim::bsdf(0), Dim::light_sample(5), Dim::bsdf(3).on_light_path(), Dim::EMIT_DIRECTION] {
+    for dim in [Dim::FILM, Dim::bsdf(0), Dim::light_sample(5)] {
         for (seed, pixel) in [(0u64, 0u64), (1, 77), (12345, 9_999_999)] {
             for m in [1u32, 4, 7, 10] {
                 for start in [0u64, 1 << m] {
@@ -105,7 +105,7 @@ fn sobol_draws_are_nets_in_every_elementary_interval() {
             }
         }
     }
-    for dim in [Dim::wavelength(0), Dim::lobe(2), Dim::roulette(7).on_light_path(), Dim::EMIT_CHOICE] {
+    for dim in [Dim::wavelength(0), Dim::lobe(2)] {
         let m = 8;
         let mut counts = vec![0u32; 1 << m];
         for k in 0..1u64 << m {
@@ -113,6 +113,41 @@ fn sobol_draws_are_nets_in_every_elementary_interval() {
         }
         assert!(counts.iter().all(|&c| c == 1), "{dim:?}");
     }
+}
+
+/// BDPT's light subpaths draw from one point set over the film: on a film of `2^m`
+/// pixels, the light subpaths of one pass (every pixel, pass fixed) are a (0,m,2)-net in
+/// every 2D light draw and put one point in every interval of length `2^-m` in every 1D
+/// one, for several m, seeds and passes; a pixel's own light draws over its passes are
+/// not (they are `pixels` apart in the film's sequence).
+#[test]
+fn light_subpaths_are_stratified_over_the_film() {
+    for m in [4u32, 7, 10] {
+        let pixels = 1u64 << m;
+        for (seed, pass) in [(0u64, 0u64), (1, 1), (12345, 37)] {
+            let sample = |p: u64| Sampler::of_kind(SamplerKind::Sobol, seed, p, pass, pixels);
+            for dim in [Dim::EMIT_POSITION, Dim::EMIT_DIRECTION, Dim::bsdf(3).on_light_path()] {
+                let pts: Vec<Vec2> = (0..pixels).map(|p| sample(p).get_2d(dim)).collect();
+                for a in 0..=m {
+                    let counts = cell_counts(&pts, a, m - a);
+                    assert!(counts.iter().all(|&c| c == 1), "{dim:?} seed {seed} pass {pass} m {m} a {a}");
+                }
+            }
+            for dim in [Dim::EMIT_CHOICE, Dim::roulette(7).on_light_path()] {
+                let mut counts = vec![0u32; 1 << m];
+                for p in 0..pixels {
+                    counts[(sample(p).get_1d(dim) * (1u64 << m) as f32) as usize] += 1;
+                }
+                assert!(counts.iter().all(|&c| c == 1), "{dim:?} seed {seed} pass {pass} m {m}");
+            }
+        }
+    }
+    // Past 2^32 light subpaths (pass 2^14 of a 2^18-pixel film) the numbers do not repeat.
+    let (big, wrap) = (1u64 << 18, 1u64 << 14);
+    let at = |pass: u64| Sampler::of_kind(SamplerKind::Sobol, 9, 5, pass, big).get_2d(Dim::EMIT_POSITION);
+    assert_ne!(at(0), at(wrap));
+    assert!(Dim::EMIT_CHOICE.is_light_path() && Dim::bsdf(0).on_light_path().is_light_path());
+    assert!(!Dim::bsdf(0).is_light_path() && !Dim::FILM.is_light_path() && !Dim::wavelength(0).is_light_path());
 }
 
 /// Off the table (deep bounces) the `sobol` sampler gives hashed numbers: uniform
@@ -143,7 +178,7 @@ fn the_fallback_is_uniform_and_independent() {
     assert!(corr(&xs, &ys).abs() < 0.02);
     let next_pixel: Vec<f64> = (0..n).map(|k| draw_2d(SamplerKind::Sobol, 1, 3, k, deep).x as f64).collect();
     assert!(corr(&xs, &next_pixel).abs() < 0.02);
-    let mut deep1 = Sampler::of_kind(SamplerKind::Sobol, 1, 2, 0);
+    let mut deep1 = Sampler::of_kind(SamplerKind::Sobol, 1, 2, 0, 1);
     assert!((0.0..1.0).contains(&deep1.get_1d(Dim::roulette(100))));
 }
 
