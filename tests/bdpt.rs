@@ -15,7 +15,7 @@ use rust_v::render::{Limits, render};
 use rust_v::scene::{Scene, load_scene, load_scene_str};
 use rust_v::settings::{IntegratorKind, SettingsPatch};
 
-use crate::common::{render_str, root};
+use crate::common::{block_means, render_str, root};
 
 fn settings(integrator: IntegratorKind, size: u32, spp: u32, seed: u64) -> SettingsPatch {
     SettingsPatch {
@@ -35,19 +35,6 @@ fn render_into(scene: &Scene, film: &mut Film, passes: std::ops::Range<u32>) {
     let stop = AtomicBool::new(false);
     let stats = render(scene, film, passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
     assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
-}
-
-/// Per-block means of Y (blocks of `b`×`b` pixels) of a film.
-fn block_means(film: &Film, b: usize) -> Vec<f64> {
-    let (w, h) = (film.width() as usize, film.height() as usize);
-    let xyz = film.mean_xyz();
-    let mut out = vec![0.0; (w / b) * (h / b)];
-    for y in 0..h {
-        for x in 0..w {
-            out[(y / b) * (w / b) + x / b] += xyz[y * w + x][1] / (b * b) as f64;
-        }
-    }
-    out
 }
 
 /// Mean and standard error, per block, over renders with different seeds.

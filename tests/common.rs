@@ -78,3 +78,16 @@ pub fn wait_for(timeout: std::time::Duration, mut cond: impl FnMut() -> bool) ->
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
 }
+
+/// Per-block means of Y (blocks of `b`×`b` pixels) of a film.
+pub fn block_means(film: &Film, b: usize) -> Vec<f64> {
+    let (w, h) = (film.width() as usize, film.height() as usize);
+    let xyz = film.mean_xyz();
+    let mut out = vec![0.0; (w / b) * (h / b)];
+    for y in 0..h {
+        for x in 0..w {
+            out[(y / b) * (w / b) + x / b] += xyz[y * w + x][1] / (b * b) as f64;
+        }
+    }
+    out
+}

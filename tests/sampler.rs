@@ -12,7 +12,7 @@ use rust_v::render::{Limits, render};
 use rust_v::scene::{Scene, load_scene, load_scene_str};
 use rust_v::settings::{IntegratorKind, SamplerKind, SettingsPatch};
 
-use crate::common::{root, rust_v, temp_dir};
+use crate::common::{block_means, root, rust_v, temp_dir};
 
 fn patch(integrator: IntegratorKind, sampler: SamplerKind, size: u32, seed: u64) -> SettingsPatch {
     SettingsPatch {
@@ -88,19 +88,6 @@ fn sobol_renders_are_deterministic_split_merged_and_resumed_exactly() {
         // The prism's light is a few pixels wide at its own 512x160: at 16x16 it may miss.
         assert!(name == "prism.ron" || whole.mean_xyz().iter().any(|p| p[1] > 0.0), "{name}: something is lit");
     }
-}
-
-/// Per-block means of Y (blocks of `b`×`b` pixels).
-fn block_means(film: &Film, b: usize) -> Vec<f64> {
-    let (w, h) = (film.width() as usize, film.height() as usize);
-    let xyz = film.mean_xyz();
-    let mut out = vec![0.0; (w / b) * (h / b)];
-    for y in 0..h {
-        for x in 0..w {
-            out[(y / b) * (w / b) + x / b] += xyz[y * w + x][1] / (b * b) as f64;
-        }
-    }
-    out
 }
 
 /// Mean and standard error per 4×4 block of Y over `seeds` renders of `spp` samples,
