@@ -719,7 +719,7 @@ impl Walk {
             passes = 0;
             let out = outside(scene, outside_material);
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
-            let prev = *path.last().expect("a subpath starts at the eye or a light");
+            let prev = path.last().expect("a subpath starts at the eye or a light");
             let mut v = Vertex {
                 kind: Kind::Surface(si.object),
                 sh,
@@ -731,8 +731,8 @@ impl Walk {
                 g_prev: 0.0,
                 outside: outside_material,
             };
-            v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, &prev, &v) };
-            v.g_prev = to_area(scene, 1.0, &v, &prev);
+            v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, prev, &v) };
+            v.g_prev = to_area(scene, 1.0, &v, prev);
             parallel = false;
             path.push(v);
             if let Some(stacks) = stacks.as_deref_mut() {
