@@ -156,6 +156,21 @@ impl Bxdf {
         }
     }
 
+    /// Which of [`Bxdf::sample_within`]'s numbers this model reads: the 2D
+    /// direction draw `u` and the 1D lobe choice `uc`. A draw it never reads
+    /// need not be drawn ([`crate::sampler::Sampler::get_1d_if`]).
+    #[inline]
+    pub fn reads_draws(&self) -> (bool, bool) {
+        match self {
+            Bxdf::Black | Bxdf::Mirror(_) => (false, false),
+            Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => (true, false),
+            Bxdf::Conductor(m) => (!m.is_smooth(), false),
+            Bxdf::Dielectric(m) => (!m.is_smooth(), true),
+            Bxdf::Plastic(_) => (true, true),
+            Bxdf::ThinSheet(_) => (false, true),
+        }
+    }
+
     /// The pdf of sampling `wi` given `wo` for the packet `lambdas` (zero
     /// for delta models; rough glass samples at the packet's index, as `sample`).
     #[inline]

@@ -372,7 +372,7 @@ impl Bdpt {
         mut stacks: Option<&mut Vec<MediumStack>>,
         wl: &mut Wavelength,
     ) {
-        let u_light = sampler.get_1d(Dim::EMIT_CHOICE);
+        let u_light = sampler.get_1d_if(scene.lights.len() > 1, Dim::EMIT_CHOICE);
         let (u_pos, u_dir) = (sampler.get_2d(Dim::EMIT_POSITION), sampler.get_2d(Dim::EMIT_DIRECTION));
         let Some((index, pmf)) = scene.choose_light(u_light) else {
             return;
@@ -524,8 +524,10 @@ impl Bdpt {
             }
             1 => {
                 // Next-event estimation: a fresh point on a light.
-                let (u_light, u) =
-                    (sampler.get_1d(Dim::light_choice(t as u32 - 2)), sampler.get_2d(Dim::light_sample(t as u32 - 2)));
+                let (u_light, u) = (
+                    sampler.get_1d_if(scene.lights.len() > 1, Dim::light_choice(t as u32 - 2)),
+                    sampler.get_2d(Dim::light_sample(t as u32 - 2)),
+                );
                 if !connectible(scene, pt) {
                     return NONE;
                 }
@@ -741,9 +743,10 @@ impl Walk {
             if path.len() >= self.max_vertices || bxdf.is_black() {
                 break;
             }
+            let (reads_u, reads_uc) = bxdf.reads_draws();
             let (u, uc) = (
-                sampler.get_2d(Dim::bsdf(bounces).on_light_path_if(self.importance)),
-                sampler.get_1d(Dim::lobe(bounces).on_light_path_if(self.importance)),
+                sampler.get_2d_if(reads_u, Dim::bsdf(bounces).on_light_path_if(self.importance)),
+                sampler.get_1d_if(reads_uc, Dim::lobe(bounces).on_light_path_if(self.importance)),
             );
             let sample = if collapsed || bxdf.dispersion_within(out).is_some() {
                 let one = wl.single();
@@ -797,7 +800,9 @@ impl Walk {
                 // subpath that has lost nothing (a delta chain through clear
                 // glass) is never cut, so exact cases stay exact.
                 let q = (beta.max_value() * eta_scale / beta_ref).min(1.0);
-                if sampler.get_1d(Dim::roulette(bounces - 1).on_light_path_if(self.importance)) >= q || q.is_nan() {
+                if sampler.get_1d_if(!(q >= 1.0), Dim::roulette(bounces - 1).on_light_path_if(self.importance)) >= q
+                    || q.is_nan()
+                {
                     break;
                 }
                 beta /= q;

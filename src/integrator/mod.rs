@@ -362,7 +362,7 @@ pub(crate) fn sample_direct<const N: usize>(
     depth: u32,
 ) -> Sampled<N> {
     let zero = Sampled::splat(0.0);
-    let u_light = sampler.get_1d(Dim::light_choice(depth));
+    let u_light = sampler.get_1d_if(scene.lights.len() > 1, Dim::light_choice(depth));
     let u = sampler.get_2d(Dim::light_sample(depth));
     let Some((index, pmf)) = scene.choose_light(u_light) else {
         return zero;

@@ -233,8 +233,9 @@ impl PathTracer {
                 l += w.beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, true, w.bounces);
             }
             // 5. The next direction.
-            let u = sampler.get_2d(Dim::bsdf(w.bounces));
-            let uc = sampler.get_1d(Dim::lobe(w.bounces));
+            let (reads_u, reads_uc) = bxdf.reads_draws();
+            let u = sampler.get_2d_if(reads_u, Dim::bsdf(w.bounces));
+            let uc = sampler.get_1d_if(reads_uc, Dim::lobe(w.bounces));
             let sample = match (reflect.take(), std::mem::replace(&mut start, Start::Camera), dispersion) {
                 (Some(weight), ..) => Some(mirror(sh.wo, weight)),
                 (None, Start::SplitRefraction, Some(d)) => refraction(d, sh.wo, lambdas),
@@ -258,7 +259,7 @@ impl PathTracer {
             // 6. Russian roulette.
             if w.bounces >= RR_DEPTH {
                 let q = (w.beta.max_value() * w.eta_scale).min(1.0);
-                if sampler.get_1d(Dim::roulette(w.bounces - 1)) >= q {
+                if sampler.get_1d_if(q < 1.0, Dim::roulette(w.bounces - 1)) >= q {
                     break;
                 }
                 w.beta /= q;

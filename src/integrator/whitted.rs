@@ -79,8 +79,9 @@ impl Whitted {
                 l += beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, false, bounces);
                 break;
             }
-            let u = sampler.get_2d(Dim::bsdf(bounces));
-            let uc = sampler.get_1d(Dim::lobe(bounces));
+            let (reads_u, reads_uc) = bxdf.reads_draws();
+            let u = sampler.get_2d_if(reads_u, Dim::bsdf(bounces));
+            let uc = sampler.get_1d_if(reads_uc, Dim::lobe(bounces));
             let Some(bs) = bxdf.sample_within(sh.wo, u, uc, lambdas, at.outside()) else {
                 break;
             };
