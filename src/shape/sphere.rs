@@ -25,7 +25,16 @@ pub(crate) fn sphere_roots(c: Vec3, r: f32, ray: &Ray) -> Option<(f32, f32)> {
     let b = 2.0 * ray.dir.dot(f);
     let cc = f.length_squared() - r * r;
     let l = f - ray.dir * (b / (2.0 * a));
-    let ll = l.length();
+    let ll2 = l.length_squared();
+    // Most rays pass well clear: reject them before the square roots and
+    // divisions. The margin (2^-10) is far above the rounding of `ll2` and
+    // `r²`, so every ray rejected here is rejected by `disc < 0` below too
+    // (`r²` must be normal: a tiny sphere's square underflows).
+    let rr = r * r;
+    if rr.is_normal() && ll2 > rr * (1.0 + 1.0 / 1024.0) {
+        return None;
+    }
+    let ll = ll2.sqrt();
     let disc = 4.0 * a * (r + ll) * (r - ll);
     if !(disc >= 0.0) {
         return None;
