@@ -18,7 +18,7 @@ use crate::camera::Camera;
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::light::Light;
 use crate::settings::Settings;
-use crate::shape::Bvh;
+use crate::shape::{Batch, Bvh};
 use crate::shape::Shape;
 
 /// Below this many bounded objects the scene tests them one by one instead of
@@ -79,6 +79,9 @@ pub struct Scene {
     /// Indices of unbounded objects (planes).
     unbounded: Vec<u32>,
     bvh: Option<Bvh>,
+    /// The bounded objects in lanes of four, for a small scene of quads and
+    /// spheres (no BVH then).
+    batch: Option<Batch>,
     /// Whether any object's material is dispersive (computed once: the
     /// `spectral` integrator asks for every camera sample).
     dispersive: bool,
@@ -122,7 +125,8 @@ impl Scene {
         let camera_media = media_at(camera.eye(), &objects, &materials);
         let nested = nested_media(&camera_media, &objects, &materials);
         let media = objects.iter().any(|o| materials[o.material as usize].as_dielectric().is_some());
-        let bvh = (bounded.len() >= BVH_MIN_OBJECTS).then(|| {
+        let batch = Batch::new(bounded.iter().map(|&i| (i, &objects[i as usize].shape)));
+        let bvh = (batch.is_none() && bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);
             bounded = bvh.prim_order().iter().map(|&k| bounded[k as usize]).collect();
             bvh
@@ -158,6 +162,7 @@ impl Scene {
             bounded,
             unbounded,
             bvh,
+            batch,
             content_hash,
             inputs: Vec::new(),
         }
@@ -182,6 +187,15 @@ impl Scene {
                 });
                 found.or(best)
             }
+            None if let Some(batch) = &self.batch => {
+                let Some((i, _)) = batch.closest(ray, t_max) else {
+                    return best;
+                };
+                // The winner's own test, for its hit record (the same `t`).
+                let hit = self.objects[i as usize].shape.intersect(ray, t_max);
+                debug_assert!(hit.is_some());
+                hit.map(|hit| SurfaceHit { hit, object: i }).or(best)
+            }
             None => {
                 for &i in &self.bounded {
                     if let Some(hit) = self.objects[i as usize].shape.intersect(ray, t_max) {
@@ -204,6 +218,7 @@ impl Scene {
             Some(bvh) => {
                 bvh.occluded(ray, t_max, |k, t| self.objects[self.bounded[k as usize] as usize].shape.occluded(ray, t))
             }
+            None if let Some(batch) = &self.batch => batch.occluded(ray, t_max),
             None => self.bounded.iter().any(|&i| self.objects[i as usize].shape.occluded(ray, t_max)),
         }
     }

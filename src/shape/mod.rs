@@ -11,6 +11,7 @@
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod batch;
 mod bubble;
 mod bvh;
 mod cuboid;
@@ -21,6 +22,7 @@ mod quad;
 mod sphere;
 mod triangle;
 
+pub use batch::Batch;
 pub use bubble::Bubble;
 pub use bvh::{Bvh, TriangleHit, WideBvh};
 pub use cuboid::Cuboid;

@@ -43,6 +43,18 @@ impl Quad {
         self.n
     }
 
+    /// `n · origin`, the plane's offset along the normal.
+    #[inline]
+    pub(crate) fn plane_offset(&self) -> f32 {
+        self.d
+    }
+
+    /// The vectors whose dot products with `q − origin` are the quad coordinates `(a, b)`.
+    #[inline]
+    pub(crate) fn projections(&self) -> (Vec3, Vec3) {
+        (self.pu, self.pv)
+    }
+
     /// Area `|edge_u x edge_v|`.
     pub fn area(&self) -> f32 {
         self.edge_u.cross(self.edge_v).length()
