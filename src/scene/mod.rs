@@ -18,8 +18,8 @@ use crate::camera::Camera;
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::light::Light;
 use crate::settings::Settings;
-use crate::shape::{Batch, Bvh};
 use crate::shape::Shape;
+use crate::shape::{Batch, Bvh};
 
 /// Below this many bounded objects the scene tests them one by one instead of
 /// building a BVH over them. Measured with callgrind (instructions for a 32x32,
@@ -188,13 +188,16 @@ impl Scene {
                 found.or(best)
             }
             None if let Some(batch) = &self.batch => {
-                let Some((i, _)) = batch.closest(ray, t_max) else {
+                let Some((object, t)) = batch.closest(ray, t_max) else {
                     return best;
                 };
-                // The winner's own test, for its hit record (the same `t`).
-                let hit = self.objects[i as usize].shape.intersect(ray, t_max);
-                debug_assert!(hit.is_some());
-                hit.map(|hit| SurfaceHit { hit, object: i }).or(best)
+                // The winner's hit record, from its `t` (as its own test builds it).
+                let hit = match &self.objects[object as usize].shape {
+                    Shape::Quad(q) => q.hit_at(ray, t),
+                    Shape::Sphere(s) => s.hit_at(ray, t),
+                    _ => unreachable!("a batch holds only quads and spheres"),
+                };
+                Some(SurfaceHit { hit, object })
             }
             None => {
                 for &i in &self.bounded {

@@ -223,7 +223,8 @@ mod tests {
     /// Random quads and spheres (some degenerate, some sharing an edge or a
     /// plane, so that ties happen), random rays from inside and outside, random
     /// `t_max`: the batch's id and `t` are exactly the scalar loop's, hit for
-    /// hit, and `occluded` agrees with it. 9 objects span three lane groups and
+    /// hit, `occluded` agrees with it, and the hit record rebuilt from `t` is
+    /// the scalar test's. 9 objects span three lane groups and
     /// a padded one.
     #[test]
     fn same_hits_as_the_scalar_tests() {
@@ -257,6 +258,19 @@ mod tests {
                 let got = batch.closest(&ray, t_max);
                 assert_eq!(got.map(|g| (g.0, g.1.to_bits())), want.map(|w| (w.0, w.1.to_bits())), "{ray:?} {t_max}");
                 assert_eq!(batch.occluded(&ray, t_max), want.is_some());
+                // The hit record built from the batch's `t` is the scalar test's, bit for bit.
+                if let Some((i, t)) = got {
+                    let full = shapes[i as usize].intersect(&ray, t_max).unwrap();
+                    let rebuilt = match &shapes[i as usize] {
+                        Shape::Quad(q) => q.hit_at(&ray, t),
+                        Shape::Sphere(s) => s.hit_at(&ray, t),
+                        _ => unreachable!(),
+                    };
+                    let bits = |h: &crate::geometry::Hit| {
+                        (h.t.to_bits(), h.p.to_array().map(f32::to_bits), h.n.to_array().map(f32::to_bits))
+                    };
+                    assert_eq!(bits(&full), bits(&rebuilt));
+                }
                 hits += want.is_some() as u32;
             }
         }

@@ -76,6 +76,15 @@ impl Quad {
         Some(Hit::flat(t, self.origin + self.edge_u * a + self.edge_v * b, n))
     }
 
+    /// The hit record of a hit at `t` already found ([`super::Batch`]): what
+    /// [`Quad::intersect`] returns for it, from the same arithmetic.
+    #[inline]
+    pub(crate) fn hit_at(&self, ray: &Ray, t: f32) -> Hit {
+        let q = ray.at(t) - self.origin;
+        let (a, b) = (q.dot(self.pu), q.dot(self.pv));
+        Hit::flat(t, self.origin + self.edge_u * a + self.edge_v * b, self.n)
+    }
+
     /// True if the ray hits the quad with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {

@@ -87,6 +87,14 @@ impl Sphere {
         Some(Hit::flat(t, p, n))
     }
 
+    /// The hit record of a hit at `t` already found ([`super::Batch`]): what
+    /// [`Sphere::intersect`] returns for it.
+    #[inline]
+    pub(crate) fn hit_at(&self, ray: &Ray, t: f32) -> Hit {
+        let (p, n) = reproject(self.center, self.radius, ray.at(t));
+        Hit::flat(t, p, n)
+    }
+
     /// True if the ray hits the sphere with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
