@@ -63,7 +63,7 @@ fn next_down(x: f32) -> f32 {
 /// coordinate then rounded one more ulp away from `p`. Since the error bound scales
 /// with the coordinates, a scene scaled by 1e-4 or 1e4 or moved far from the origin
 /// behaves the same.
-#[inline]
+#[inline(always)]
 pub fn offset_ray_origin(p: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
     let d = point_error(p);
     let mut offset = n * d;
@@ -96,7 +96,7 @@ impl Ray {
 
     /// A ray leaving surface point `p` (geometric normal `n`) in direction `dir`, with its
     /// origin offset along ±n to the side `dir` points to, robust against self-intersection.
-    #[inline]
+    #[inline(always)]
     pub fn spawn(p: Vec3, n: Vec3, dir: Vec3) -> Ray {
         Ray { origin: offset_ray_origin(p, n, dir), dir }
     }
@@ -105,7 +105,7 @@ impl Ray {
     /// the ray and the `t_max` to use so that the target's own surface is not hit: the
     /// distance shortened by `SHADOW_EPSILON` relative and by the target's own
     /// coordinate error bound. Coincident points give `t_max = 0`.
-    #[inline]
+    #[inline(always)]
     pub fn spawn_to(p: Vec3, n: Vec3, target: Vec3) -> (Ray, f32) {
         let origin = offset_ray_origin(p, n, target - p);
         let d = target - origin;

@@ -350,7 +350,7 @@ pub(crate) struct Surround<'a> {
 /// medium it runs in, `surround`), and the MIS weight against BSDF sampling
 /// (power heuristic) when `mis` is set. Its numbers are the draws of depth `depth`.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 pub(crate) fn sample_direct<const N: usize>(
     scene: &Scene,
     bxdf: &Bxdf,

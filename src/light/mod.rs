@@ -112,7 +112,7 @@ impl Light {
     }
 
     /// Samples a direction from point `p` towards the light.
-    #[inline]
+    #[inline(always)]
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match self {
             Light::Point(l) => l.sample_li(p),

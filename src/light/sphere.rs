@@ -36,7 +36,7 @@ impl SphereLight {
     }
 
     /// Samples a direction from `p` towards the sphere.
-    #[inline]
+    #[inline(always)]
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         let sphere = &self.sphere;
         let to_c = sphere.center - p;
