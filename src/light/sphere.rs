@@ -14,7 +14,7 @@ use std::f32::consts::PI;
 use super::{LightSample, sides};
 use crate::color::Spectrum;
 use crate::geometry::Frame;
-use crate::sampler::warp::uniform_sphere;
+use crate::sampler::warp::{cos_sin_2pi, uniform_sphere};
 use crate::shape::Sphere;
 
 /// A spherical area light emitting `radiance` outward (and inward too when two-sided).
@@ -70,8 +70,8 @@ impl SphereLight {
         let cos_t = 1.0 - v;
         let sin2_t = (v * (2.0 - v)).max(0.0);
         let sin_t = sin2_t.sqrt();
-        let phi = 2.0 * PI * u.y;
-        let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t);
+        let (cos_phi, sin_phi) = cos_sin_2pi(u.y);
+        let local = Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t);
         let wi = frame.to_world(local).normalize();
         // Distance to the near intersection along wi (pbrt-v4 eq. 6.x, stable form).
         let dist = d * cos_t - (r2 - d2 * sin2_t).max(0.0).sqrt();
