@@ -800,7 +800,7 @@ impl Walk {
                 // subpath that has lost nothing (a delta chain through clear
                 // glass) is never cut, so exact cases stay exact.
                 let q = (beta.max_value() * eta_scale / beta_ref).min(1.0);
-                if sampler.get_1d_if(!(q >= 1.0), Dim::roulette(bounces - 1).on_light_path_if(self.importance)) >= q
+                if sampler.get_1d_if(q < 1.0, Dim::roulette(bounces - 1).on_light_path_if(self.importance)) >= q
                     || q.is_nan()
                 {
                     break;
