@@ -158,7 +158,7 @@ impl Bxdf {
 
     /// Which of [`Bxdf::sample_within`]'s numbers this model reads: the 2D
     /// direction draw `u` and the 1D lobe choice `uc`. A draw it never reads
-    /// need not be drawn ([`crate::sampler::Sampler::get_1d_if`]).
+    /// need not be drawn (the sampler's `get_1d_if` and `get_2d_if`).
     #[inline]
     pub fn reads_draws(&self) -> (bool, bool) {
         match self {
