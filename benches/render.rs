@@ -49,6 +49,7 @@ fn main() {
             ("hero-8", IntegratorKind::Spectral, 8),
             ("bdpt", IntegratorKind::Bdpt, 4),
             ("lighttrace", IntegratorKind::LightTrace, 4),
+            ("whitted", IntegratorKind::Whitted, 4),
         ];
         for (name, integrator, packet) in methods {
             let overrides = SettingsPatch {
