@@ -1,12 +1,12 @@
 //! Four triangles in one block, coordinates stored lane by lane (`[vertex][axis][lane]`),
 //! and the watertight test of [`TriRay`] run on the four lanes at once. Each of the
 //! test's quantities is one glam `Vec4` (an SSE register): one coordinate of one vertex
-//! of all four triangles is one load, and every operation is one packed instruction. Written as loops over fixed
-//! `[f32; 4]` arrays, the same test compiled to scalar loads and shuffles, about 370
-//! instructions a block; this form takes about 330 fewer (docs/performance.md, round 4). The
-//! arithmetic is exactly the single-triangle test's, operation by operation (no fused
-//! multiply-add), so a lane returns the same `t` bit for bit (tested), and images do not
-//! change.
+//! of all four triangles is one load, and every operation is one packed instruction.
+//! Written as loops over fixed `[f32; 4]` arrays, the same test compiled to scalar loads
+//! and shuffles, about 370 instructions a block; this form takes about 330 fewer
+//! (docs/performance.md, round 4). The arithmetic is exactly the single-triangle test's,
+//! operation by operation (no fused multiply-add), so a lane returns the same `t` bit for
+//! bit (tested), and images do not change.
 //!
 //! A block holds one to four triangles; unused lanes repeat lane 0, so they can only
 //! report lane 0's hit again, at the same `t` (closest-hit keeps the first lane on ties).
