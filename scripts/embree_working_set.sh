@@ -58,7 +58,7 @@ EOF
     r+=("$(EMBREE_DATA=$dir "$bin" --kinds incoherent --passes 5 --no-hits | grep -oE '[0-9.]+ Mrays/s median' | cut -d' ' -f1)")
     echo "N=$n round $((k + 1)): Embree ${e[-1]}, rust-v ${r[-1]}" >&2
   done
-  em=$(printf '%s\n' "${e[@]}" | median)
-  rm=$(printf '%s\n' "${r[@]}" | median)
-  echo "| $n | $em | $rm | $(awk -v a="$rm" -v b="$em" 'BEGIN {printf "%.2f", a / b}') |"
+  e_med=$(printf '%s\n' "${e[@]}" | median)
+  r_med=$(printf '%s\n' "${r[@]}" | median)
+  echo "| $n | $e_med | $r_med | $(awk -v a="$r_med" -v b="$e_med" 'BEGIN {printf "%.2f", a / b}') |"
 done
