@@ -76,6 +76,16 @@ fn main() {
         bvh.sah_cost()
     );
     println!("geometry_sha256 {hash}");
+    // The BVH asks for huge pages (src/shape/bvh/hint.rs); say how many the process has.
+    if let Some(kb) = std::fs::read_to_string("/proc/self/smaps_rollup")
+        .ok()
+        .and_then(|s| s.lines().find_map(|l| l.strip_prefix("AnonHugePages:").map(|v| v.trim().to_string())))
+    {
+        println!(
+            "huge pages: {kb} in the process; BVH nodes + blocks {:.1} MB",
+            (bvh.memory_bytes() + bvh.triangle_bytes()) as f64 * 1e-6
+        );
+    }
 
     for kind in &kinds {
         let rays_path = data.join(format!("rays/{stem}.{kind}.rays"));

@@ -19,6 +19,7 @@ use crate::geometry::{Aabb, Ray, gamma};
 use glam::Vec3;
 
 mod build;
+mod hint;
 mod tri4;
 mod wide;
 

@@ -21,6 +21,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::build::{Limits, build_tree};
+use super::hint::{advise_huge_pages, prefetch_block, prefetch_node};
 use super::tri4::Tri4;
 use super::{JOIN_THRESHOLD, Node, PARALLEL_THRESHOLD, ROBUST};
 use crate::geometry::{Aabb, Ray};
@@ -196,7 +197,19 @@ impl WideBvh {
         w.nodes.shrink_to_fit();
         w.blocks.shrink_to_fit();
         w.block_first.shrink_to_fit();
+        advise_huge_pages(&w.nodes);
+        advise_huge_pages(&w.blocks);
         w
+    }
+
+    /// Requests the cache lines of child reference `r` (a node or a leaf's first block).
+    #[inline(always)]
+    fn prefetch(&self, r: u32) {
+        if r & LEAF == 0 {
+            prefetch_node(self.nodes.as_ptr().wrapping_add(r as usize));
+        } else {
+            prefetch_block(self.blocks.as_ptr().wrapping_add((r & BLOCK_MASK) as usize));
+        }
     }
 
     /// Slot order: `prim_order()[slot]` is the triangle's index in the slice given to
@@ -286,6 +299,13 @@ impl WideBvh {
                     }
                 }
                 if n > 0 {
+                    // Every child to be visited is requested now: the pending ones
+                    // arrive while the nearest is visited, and all lines of each come
+                    // at once (see `hint`). Prefetching only the pending ones measured
+                    // 4.08 against 4.40 Mrays/s on incoherent rays.
+                    for &(_, r) in &c[..n] {
+                        self.prefetch(r);
+                    }
                     for i in 1..n {
                         let x = c[i];
                         let mut j = i;
@@ -352,6 +372,7 @@ impl WideBvh {
                 let e = rb.entry(node, t_max);
                 for l in 0..4 {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
+                        self.prefetch(node.child[l]);
                         stack[sp] = node.child[l];
                         sp += 1;
                     }
