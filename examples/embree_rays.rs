@@ -70,10 +70,14 @@ fn main() {
     let n = mesh.triangle_count();
     let bvh = mesh.bvh();
     println!(
-        "{name}: {n} triangles + {} degenerate dropped; load+build {load:.2} s; {:.1} B/tri BVH; SAH {:.2}",
+        "{name}: {n} triangles + {} degenerate dropped; load+build {load:.2} s; {:.1} B/tri BVH; SAH {:.2}; \
+         {} nodes, {} blocks ({:.1}% of lanes used)",
         mesh.degenerate_dropped(),
         bvh.memory_bytes() as f64 / n as f64,
-        bvh.sah_cost()
+        bvh.sah_cost(),
+        bvh.node_count(),
+        bvh.block_count(),
+        100.0 * n as f64 / (4 * bvh.block_count()) as f64
     );
     println!("geometry_sha256 {hash}");
     // The BVH asks for huge pages (src/shape/bvh/hint.rs); say how many the process has.

@@ -5,7 +5,7 @@
 //! its two cache lines, and the child to visit next is known only after that test. Two
 //! hints overlap or shorten those waits, as Embree does (docs/performance.md, round 5):
 //!
-//! - [`prefetch_node`] / [`prefetch_block`]: when a node's children are known, their
+//! - [`prefetch_node`] / [`prefetch_blocks`]: when a node's children are known, their
 //!   lines are requested at once, so the pending ones arrive while the nearest is visited;
 //! - [`advise_huge_pages`]: the node and block arrays are backed by 2 MiB pages where the
 //!   kernel agrees, so a miss to memory no longer also misses the TLB (50 MB in 4 KiB
@@ -27,14 +27,19 @@ pub(super) fn prefetch_node<T>(p: *const T) {
     prefetch(p.wrapping_add(64));
 }
 
-/// Requests the three cache lines that a 144-byte triangle block at `p` can span (it is
-/// 16-byte aligned: its last byte is at most 48 + 143 = 191 bytes past a line start).
+/// Requests the cache lines of `n` consecutive 144-byte triangle blocks starting at `p`
+/// (16-byte aligned, so the last byte sits at most 48 + 144 n - 1 bytes past the line
+/// holding `p`).
 #[inline(always)]
-pub(super) fn prefetch_block<T>(p: *const T) {
+pub(super) fn prefetch_blocks<T>(p: *const T, n: usize) {
     let p = p.cast::<u8>();
-    prefetch(p);
-    prefetch(p.wrapping_add(64));
-    prefetch(p.wrapping_add(128));
+    let first = p as usize & !63;
+    let last = (p as usize).wrapping_add(144 * n - 1);
+    let mut line = 0;
+    while first.wrapping_add(line) <= last {
+        prefetch(p.wrapping_add(line));
+        line += 64;
+    }
 }
 
 /// A prefetch of the line holding `p` into all cache levels (`prefetcht0`). Any address
@@ -127,9 +132,9 @@ mod tests {
         // Prefetches of any address, inside the data or not, change nothing.
         for k in [0, 1000, data.len() - 1] {
             prefetch_node(&data[k]);
-            prefetch_block(&data[k]);
+            prefetch_blocks(&data[k], 1 + k % 3);
         }
-        prefetch_block(std::ptr::null::<u8>());
+        prefetch_blocks(std::ptr::null::<u8>(), 3);
         prefetch_node(usize::MAX as *const u8);
         assert_eq!(data[1000], 1000u32.wrapping_mul(2_654_435_761));
     }

@@ -5,8 +5,8 @@
 //!
 //! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
 //! grandchildren (or, beside a leaf child, its other child's children, then the children
-//! of the largest of those), and a subtree of at most four triangles becomes one leaf
-//! block. Leaves keep the binary tree's slot order, so the triangles' storage order (and
+//! of the largest of those), and a subtree of at most [`LEAF_TRIANGLES`] triangles becomes
+//! one leaf of up to three blocks. Leaves keep the binary tree's slot order, so the triangles' storage order (and
 //! `Hit::prim`) is the binary tree's; the tree is as deterministic as that build.
 //!
 //! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
@@ -21,7 +21,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::build::{Limits, build_tree};
-use super::hint::{advise_huge_pages, prefetch_block, prefetch_node};
+use super::hint::{advise_huge_pages, prefetch_blocks, prefetch_node};
 use super::tri4::Tri4;
 use super::{JOIN_THRESHOLD, Node, PARALLEL_THRESHOLD, ROBUST};
 use crate::geometry::{Aabb, Ray};
@@ -30,6 +30,14 @@ use glam::Vec3;
 
 /// Depth limit of the binary tree that is collapsed (see the module doc).
 const BINARY_DEPTH: u32 = 42;
+/// Largest binary subtree that becomes a leaf (three full blocks). Measured on the full
+/// dragon's incoherent rays against 4 (one block per leaf, the binary SAH's own cost
+/// model): 8 gave +7%, 12 +11% (per-round median of 9 alternated runs), 16 +13%, 24
+/// less again; 12 also cuts nodes and index data from 24.7 to 12.8 bytes per triangle
+/// and fills 86% of block lanes instead of 76% (docs/performance.md, round 5). A node
+/// visit costs more than the SAH's unit here: it is a dependent cache miss, while a
+/// leaf's blocks are contiguous and fetched together.
+const LEAF_TRIANGLES: u32 = 12;
 /// Traversal stack entries: three pending children per node level, plus one.
 const STACK: usize = 3 * (BINARY_DEPTH as usize / 2) + 1;
 /// Reference flag of a leaf; its bits 28-30 hold the block count minus one and bits
@@ -208,7 +216,8 @@ impl WideBvh {
         if r & LEAF == 0 {
             prefetch_node(self.nodes.as_ptr().wrapping_add(r as usize));
         } else {
-            prefetch_block(self.blocks.as_ptr().wrapping_add((r & BLOCK_MASK) as usize));
+            let n = ((r >> 28) & 7) as usize + 1;
+            prefetch_blocks(self.blocks.as_ptr().wrapping_add((r & BLOCK_MASK) as usize), n);
         }
     }
 
@@ -403,7 +412,7 @@ struct Collapse<'a, F> {
 impl<F: Fn(usize) -> [Vec3; 3]> Collapse<'_, F> {
     /// True if binary node `i` becomes a 4-wide node (not a leaf).
     fn opens(&self, i: usize) -> bool {
-        self.bin[i].count == 0 && self.range[i].1 > 4
+        self.bin[i].count == 0 && self.range[i].1 > LEAF_TRIANGLES
     }
 
     /// The reference of binary subtree `i`, appending its nodes and blocks depth first.
