@@ -27,6 +27,12 @@ pub(super) fn prefetch_node<T>(p: *const T) {
     prefetch(p.wrapping_add(64));
 }
 
+/// Requests the cache line holding `p` (an index entry read once the traversal ends).
+#[inline(always)]
+pub(super) fn prefetch_line<T>(p: *const T) {
+    prefetch(p.cast::<u8>());
+}
+
 /// Requests the cache lines of `n` consecutive 144-byte triangle blocks starting at `p`
 /// (16-byte aligned, so the last byte sits at most 48 + 144 n - 1 bytes past the line
 /// holding `p`).
@@ -132,6 +138,7 @@ mod tests {
         // Prefetches of any address, inside the data or not, change nothing.
         for k in [0, 1000, data.len() - 1] {
             prefetch_node(&data[k]);
+            prefetch_line(&data[k]);
             prefetch_blocks(&data[k], 1 + k % 3);
         }
         prefetch_blocks(std::ptr::null::<u8>(), 3);

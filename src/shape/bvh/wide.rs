@@ -21,7 +21,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::build::{Limits, build_tree};
-use super::hint::{advise_huge_pages, prefetch_blocks, prefetch_node};
+use super::hint::{advise_huge_pages, prefetch_blocks, prefetch_line, prefetch_node};
 use super::tri4::Tri4;
 use super::{JOIN_THRESHOLD, Node, PARALLEL_THRESHOLD, ROBUST};
 use crate::geometry::{Aabb, Ray};
@@ -339,6 +339,8 @@ impl WideBvh {
                         if t < t_max {
                             t_max = t;
                             best = Some((b, l));
+                            // Read when the traversal ends; a miss there waited on its own.
+                            prefetch_line(self.block_first.as_ptr().wrapping_add(b));
                         }
                     }
                 }
