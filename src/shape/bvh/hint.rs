@@ -1,6 +1,6 @@
 //! Hints to the memory system for the triangle BVH: the crate's only `unsafe` code.
 //!
-//! Incoherent rays through a large mesh (the full Stanford dragon: 50 MB of nodes and
+//! Incoherent rays through a large mesh (the full Stanford dragon: 48 MB of nodes and
 //! triangle blocks) spend most of their time waiting for memory: a node's box test needs
 //! its two cache lines, and the child to visit next is known only after that test. Two
 //! hints overlap or shorten those waits, as Embree does (docs/performance.md, round 5):
@@ -8,8 +8,8 @@
 //! - [`prefetch_node`] / [`prefetch_blocks`]: when a node's children are known, their
 //!   lines are requested at once, so the pending ones arrive while the nearest is visited;
 //! - [`advise_huge_pages`]: the node and block arrays are backed by 2 MiB pages where the
-//!   kernel agrees, so a miss to memory no longer also misses the TLB (50 MB in 4 KiB
-//!   pages is 12,800 translations; the L2 TLB holds about 3,000).
+//!   kernel agrees, so a miss to memory no longer also misses the TLB (48 MB in 4 KiB
+//!   pages is 12,288 translations; the L2 TLB holds about 3,000).
 //!
 //! Neither changes a value the program computes: a prefetch only moves a line into the
 //! cache, and `madvise(MADV_HUGEPAGE)` / `madvise(MADV_COLLAPSE)` only change how pages

@@ -6,8 +6,10 @@
 //! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
 //! grandchildren (or, beside a leaf child, its other child's children, then the children
 //! of the largest of those), and a subtree of at most [`LEAF_TRIANGLES`] triangles becomes
-//! one leaf of up to three blocks. Leaves keep the binary tree's slot order, so the triangles' storage order (and
-//! `Hit::prim`) is the binary tree's; the tree is as deterministic as that build.
+//! one leaf of up to three blocks. Leaves keep the binary tree's slot order, so the
+//! triangles' storage order (and `Hit::prim`) is the binary tree's; the tree is as
+//! deterministic as that build. Every child a ray is about to visit is prefetched, and
+//! the node and block arrays are advised into huge pages (`hint.rs`).
 //!
 //! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
 //! under 32 bytes per triangle, the vertices live in the blocks.
@@ -210,7 +212,7 @@ impl WideBvh {
         w
     }
 
-    /// Requests the cache lines of child reference `r` (a node or a leaf's first block).
+    /// Requests the cache lines of child reference `r` (a node, or all of a leaf's blocks).
     #[inline(always)]
     fn prefetch(&self, r: u32) {
         if r & LEAF == 0 {
@@ -529,6 +531,33 @@ mod tests {
             assert_eq!(w.occluded(&ray, t_max), want.is_some(), "ray {i}: occluded");
         }
         hits
+    }
+
+    /// Triangles under reference `r`, checking on the way that every leaf holds at most
+    /// [`LEAF_TRIANGLES`] of them in as few blocks as that takes, and every node more.
+    fn covered(w: &WideBvh, r: u32) -> u32 {
+        if r & LEAF != 0 {
+            let (first, nb) = ((r & BLOCK_MASK) as usize, ((r >> 28) & 7) as usize + 1);
+            let end = w.block_first.get(first + nb).copied().unwrap_or(w.order.len() as u32);
+            let n = end - w.block_first[first];
+            assert!(n <= LEAF_TRIANGLES && nb == n.div_ceil(4) as usize, "leaf of {n} triangles in {nb} blocks");
+            return n;
+        }
+        let n = w.nodes[r as usize].child.iter().filter(|&&c| c != EMPTY).map(|&c| covered(w, c)).sum();
+        assert!(n > LEAF_TRIANGLES, "a node over {n} triangles should have been a leaf");
+        n
+    }
+
+    #[test]
+    fn leaves_hold_at_most_leaf_triangles_and_nodes_more() {
+        for n in [1, 12, 13, 3000] {
+            let w = WideBvh::build(&verts(&soup(n, 4)));
+            assert_eq!(covered(&w, w.root), n as u32);
+            // Fuller blocks than one leaf per four-triangle subtree gave (76% on the dragon).
+            if n == 3000 {
+                assert!(n as f64 / (4 * w.block_count()) as f64 > 0.8, "{} blocks", w.block_count());
+            }
+        }
     }
 
     #[test]
