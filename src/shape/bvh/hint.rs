@@ -33,14 +33,14 @@ pub(super) fn prefetch_line<T>(p: *const T) {
     prefetch(p.cast::<u8>());
 }
 
-/// Requests the cache lines of `n` consecutive 144-byte triangle blocks starting at `p`
-/// (16-byte aligned, so the last byte sits at most 48 + 144 n - 1 bytes past the line
-/// holding `p`).
+/// Requests every cache line of `n` consecutive values of `T` starting at `p` (a leaf's
+/// triangle blocks: 144 bytes each, 16-byte aligned, so one block spans three lines).
 #[inline(always)]
 pub(super) fn prefetch_blocks<T>(p: *const T, n: usize) {
+    let bytes = size_of::<T>() * n;
     let p = p.cast::<u8>();
     let first = p as usize & !63;
-    let last = (p as usize).wrapping_add(144 * n - 1);
+    let last = (p as usize).wrapping_add(bytes.max(1) - 1);
     let mut line = 0;
     while first.wrapping_add(line) <= last {
         prefetch(p.wrapping_add(line));
