@@ -53,6 +53,14 @@ impl Tri4 {
     /// every lane rounds exactly as [`TriRay::intersect`] does.
     #[inline(always)]
     pub(super) fn hit_t(&self, r: &TriRay, t_max: f32) -> [f32; 4] {
+        self.hit(r, t_max).0
+    }
+
+    /// [`Tri4::hit_t`], and each lane's edge functions `[u, v, w]` (the barycentric
+    /// weights before they are divided by their sum `u + v + w`), exactly as
+    /// [`TriRay::intersect`] computes them: the closest hit's weights need no second test.
+    #[inline(always)]
+    pub(super) fn hit(&self, r: &TriRay, t_max: f32) -> ([f32; 4], [Vec4; 3]) {
         let (kx, ky, kz) = (r.kx, r.ky, r.kz);
         let o = r.origin.to_array();
         let (ox, oy, oz) = (Vec4::splat(o[kx]), Vec4::splat(o[ky]), Vec4::splat(o[kz]));
@@ -98,7 +106,7 @@ impl Tri4 {
         let range = (neg & range_neg) | (!neg & range_pos);
         let t = tt * (Vec4::ONE / det);
         let hit = !outside & det.cmpne(z) & range & t.cmpgt(z) & t.cmplt(Vec4::splat(t_max));
-        Vec4::select(hit, t, Vec4::INFINITY).to_array()
+        (Vec4::select(hit, t, Vec4::INFINITY).to_array(), [u, v, w])
     }
 }
 

@@ -336,11 +336,11 @@ impl WideBvh {
             } else {
                 let first = (cur & BLOCK_MASK) as usize;
                 for b in first..=first + ((cur >> 28) & 7) as usize {
-                    let ts = self.blocks[b].hit_t(&tr, t_max);
+                    let (ts, uvw) = self.blocks[b].hit(&tr, t_max);
                     for (l, &t) in ts.iter().enumerate() {
                         if t < t_max {
                             t_max = t;
-                            best = Some((b, l));
+                            best = Some((b, l, uvw));
                             // Read when the traversal ends; a miss there waited on its own.
                             prefetch_line(self.block_first.as_ptr().wrapping_add(b));
                         }
@@ -350,11 +350,14 @@ impl WideBvh {
             // Pop the next child still in front of the closest hit.
             loop {
                 if sp == 0 {
-                    let (b, l) = best?;
-                    let v = self.blocks[b].triangle(l);
-                    let (t, b0, b1, b2) = tr.intersect(v[0], v[1], v[2], f32::INFINITY)?;
-                    debug_assert_eq!(t, t_max);
-                    return Some(TriangleHit { slot: self.block_first[b] + l as u32, t, b: [b0, b1, b2], v });
+                    // The winning lane's weights, divided as `TriRay::intersect` divides
+                    // them (the same operations, so the same bits: tested).
+                    let (b, l, uvw) = best?;
+                    let [u, v, w] = uvw.map(|x| x[l]);
+                    let inv = 1.0 / (u + v + w);
+                    let slot = self.block_first[b] + l as u32;
+                    let v3 = self.blocks[b].triangle(l);
+                    return Some(TriangleHit { slot, t: t_max, b: [u * inv, v * inv, w * inv], v: v3 });
                 }
                 sp -= 1;
                 let (r, t) = stack[sp];
@@ -518,6 +521,13 @@ mod tests {
                     assert!(k == k_got || brute(&tris[k_got as usize..=k_got as usize], &ray, t_max).unwrap().0 == t);
                     let tri = &tris[k_got as usize];
                     assert_eq!(h.v, [tri.v0, tri.v1, tri.v2]);
+                    // The weights kept from the lane test are the scalar test's, bit for bit.
+                    let (ts, b0, b1, b2) = TriRay::new(&ray).intersect(tri.v0, tri.v1, tri.v2, t_max).unwrap();
+                    assert_eq!(
+                        [ts, b0, b1, b2].map(f32::to_bits),
+                        [h.t, h.b[0], h.b[1], h.b[2]].map(f32::to_bits),
+                        "ray {i}: t and weights"
+                    );
                     assert_eq!(w.triangle(h.slot), h.v);
                     let p = h.v[0] * h.b[0] + h.v[1] * h.b[1] + h.v[2] * h.b[2];
                     assert!(
