@@ -34,23 +34,26 @@ pub struct TriRay {
 impl TriRay {
     /// Precomputes the permutation (the dominant direction axis becomes z, winding kept)
     /// and the shear that maps the ray direction to +z.
+    ///
+    /// Written without branches: the axes follow the ray's direction, which for incoherent
+    /// rays no predictor learns (the nested `if`s this replaces cost about 1.2
+    /// mispredictions a ray in callgrind's model). Ties and NaN pick as the nested form
+    /// did: `kz` is x if `|d.x| > |d.y|` and `|d.x| > |d.z|`, else y if `|d.y| > |d.z|`
+    /// (and not the x case), else z.
     #[inline]
     pub fn new(ray: &Ray) -> TriRay {
         let a = ray.dir.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z { 0 } else { 2 }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if ray.dir[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let dz = ray.dir[kz];
-        TriRay { origin: ray.origin, kx, ky, kz, sx: ray.dir[kx] / dz, sy: ray.dir[ky] / dz, sz: 1.0 / dz }
+        let x_over_y = a.x > a.y;
+        let (m, i) = if x_over_y { (a.x, 0) } else { (a.y, 1) };
+        // i if m > |d.z| (false for NaN), else 2.
+        let kz = 2 - (m > a.z) as usize * (2 - i);
+        let d = ray.dir.to_array();
+        let dz = d[kz];
+        // (kz + 1) % 3 and (kz + 2) % 3, swapped when dz < 0 (the winding is kept).
+        let (k1, k2) = ([1, 2, 0][kz], [2, 0, 1][kz]);
+        let swap = 0usize.wrapping_sub((dz < 0.0) as usize) & (k1 ^ k2);
+        let (kx, ky) = (k1 ^ swap, k2 ^ swap);
+        TriRay { origin: ray.origin, kx, ky, kz, sx: d[kx] / dz, sy: d[ky] / dz, sz: 1.0 / dz }
     }
 
     /// Watertight test against triangle `(p0, p1, p2)`: `Some((t, b0, b1, b2))` for a hit
@@ -144,6 +147,44 @@ mod tests {
     use super::*;
     use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
+
+    /// The branch-free axis choice of `TriRay::new` against the nested `if`s of Woop et
+    /// al.'s paper (which it replaced), on ties, zeros, signed zeros, infinities and NaN.
+    #[test]
+    fn permutation_matches_the_nested_form() {
+        fn nested(d: Vec3) -> (usize, usize, usize) {
+            let a = d.abs();
+            let kz = if a.x > a.y {
+                if a.x > a.z { 0 } else { 2 }
+            } else if a.y > a.z {
+                1
+            } else {
+                2
+            };
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if d[kz] < 0.0 {
+                std::mem::swap(&mut kx, &mut ky);
+            }
+            (kx, ky, kz)
+        }
+        let vals = [0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN];
+        let mut seen = std::collections::HashSet::new();
+        for &x in &vals {
+            for &y in &vals {
+                for &z in &vals {
+                    let d = Vec3::new(x, y, z);
+                    let r = TriRay::new(&Ray { origin: Vec3::ZERO, dir: d });
+                    let want = nested(d);
+                    assert_eq!((r.kx, r.ky, r.kz), want, "direction {d}");
+                    seen.insert(want);
+                    let dz = d.to_array()[want.2];
+                    assert_eq!(r.sz.to_bits(), (1.0 / dz).to_bits(), "direction {d}");
+                }
+            }
+        }
+        // Every axis as z, with both windings.
+        assert_eq!(seen.len(), 6, "{seen:?}");
+    }
 
     #[test]
     fn closed_form_hit_and_normal() {
