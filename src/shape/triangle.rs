@@ -36,7 +36,7 @@ impl TriRay {
     /// and the shear that maps the ray direction to +z.
     ///
     /// Written without branches: the axes follow the ray's direction, which for incoherent
-    /// rays no predictor learns (the nested `if`s this replaces cost about 1.2
+    /// rays no predictor learns (the nested `if`s this replaces cost about 1.1
     /// mispredictions a ray in callgrind's model). Ties and NaN pick as the nested form
     /// did: `kz` is x if `|d.x| > |d.y|` and `|d.x| > |d.z|`, else y if `|d.y| > |d.z|`
     /// (and not the x case), else z.
