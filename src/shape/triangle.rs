@@ -177,8 +177,13 @@ mod tests {
                     let want = nested(d);
                     assert_eq!((r.kx, r.ky, r.kz), want, "direction {d}");
                     seen.insert(want);
-                    let dz = d.to_array()[want.2];
-                    assert_eq!(r.sz.to_bits(), (1.0 / dz).to_bits(), "direction {d}");
+                    let da = d.to_array();
+                    let dz = da[want.2];
+                    assert_eq!(
+                        [r.sx, r.sy, r.sz].map(f32::to_bits),
+                        [da[want.0] / dz, da[want.1] / dz, 1.0 / dz].map(f32::to_bits),
+                        "direction {d}"
+                    );
                 }
             }
         }
