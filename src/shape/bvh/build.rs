@@ -8,13 +8,20 @@
 //! bins of large nodes are filled in parallel over fixed chunks and merged in chunk
 //! order, and a bin holds only minima, maxima and counts, which are exact whatever the
 //! order of the merge.
+//!
+//! Passes over the primitives: one for the root's bounds, then per node one to bin and
+//! one to partition. A child's box is the union of the bins on its side of the split and
+//! its centroid bounds are gathered by the partition, which computes every centroid
+//! anyway (both exact: the values a pass over the child would give). The SAH sweep visits
+//! only occupied bins, which is most of the saving on small nodes (docs/performance.md,
+//! round 7).
 
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use super::Node;
 use crate::geometry::Aabb;
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
 /// Number of SAH bins per axis.
@@ -63,6 +70,19 @@ impl Box3A {
 
     fn aabb(self) -> Aabb {
         Aabb { min: self.min.into(), max: self.max.into() }
+    }
+
+    /// [`Aabb::surface_area`] with the same operations in the same order (so the same
+    /// bits), in SIMD registers: 0 unless `min <= max` on every axis (an empty or NaN
+    /// box).
+    #[inline(always)]
+    fn surface_area(self) -> f32 {
+        if !self.min.cmple(self.max).all() {
+            return 0.0;
+        }
+        let d = self.max - self.min;
+        let p = d * Vec3A::new(d.y, d.z, d.x);
+        2.0 * (p.x + p.y + p.z)
     }
 }
 
@@ -119,7 +139,8 @@ pub(super) fn build_tree(
         if n > limits.threshold { (0..n).into_par_iter().map(prim).collect() } else { (0..n).map(prim).collect() };
     let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
     if !prims.is_empty() {
-        build_node(&mut prims, 0, 0, &mut nodes, limits);
+        let (bounds, centroids) = node_bounds(&prims, limits.threshold);
+        build_node(&mut prims, bounds, centroids, 0, 0, &mut nodes, limits);
     }
     nodes.shrink_to_fit();
     let order = prims.iter().map(|p| p.index()).collect();
@@ -144,62 +165,87 @@ type Bins = [[Bin; BINS]; 3];
 
 const EMPTY_BINS: Bins = [[Bin { bounds: Box3A::EMPTY, count: 0 }; BINS]; 3];
 
-/// Bin of centroid coordinate `c` (same formula for binning and partitioning).
+/// Bin of centroid coordinate `c` on one axis (partitioning).
 #[inline(always)]
 fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
     (((c - lo) * scale) as usize).min(BINS - 1)
 }
 
+/// [`bin_of`] on the three axes at once (binning): the same products lane by lane, and
+/// the same index for every value, NaN included: `max` with 0 gives 0 for NaN and for
+/// negative values as the saturating `as usize` does, `min` the last bin.
+#[inline(always)]
+fn bins_of(c: Vec3A, lo: Vec3A, scale: Vec3A) -> [usize; 3] {
+    let x = ((c - lo) * scale).max(Vec3A::ZERO).min(Vec3A::splat((BINS - 1) as f32));
+    x.as_uvec3().to_array().map(|i| i as usize)
+}
+
 /// Adds `prims` to `bins`.
-fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3, scale: [f32; 3]) {
+fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3A, scale: Vec3A) {
     for p in prims {
-        let c = p.centroid();
+        let b = p.bounds();
+        let i = bins_of((b.min + b.max) * 0.5, lo, scale);
         for a in 0..3 {
-            let b = &mut bins[a][bin_of(c[a], lo[a], scale[a])];
-            b.count += 1;
-            b.bounds = b.bounds.union(p.bounds());
+            let bin = &mut bins[a][i[a]];
+            bin.count += 1;
+            bin.bounds = bin.bounds.union(b);
         }
     }
 }
 
 /// Bounds and centroid bounds of `prims` (in parallel over fixed chunks when large).
-fn node_bounds(prims: &[BuildPrim], threshold: usize) -> (Aabb, Aabb) {
+fn node_bounds(prims: &[BuildPrim], threshold: usize) -> (Box3A, Box3A) {
     let one = |ps: &[BuildPrim]| {
         ps.iter().fold((Box3A::EMPTY, Box3A::EMPTY), |(b, c), p| (b.union(p.bounds()), c.grow(p.centroid())))
     };
-    let (b, c) = if prims.len() > threshold {
+    if prims.len() > threshold {
         let parts: Vec<(Box3A, Box3A)> = prims.par_chunks(BIN_CHUNK).map(one).collect();
         parts.iter().fold((Box3A::EMPTY, Box3A::EMPTY), |(b, c), (pb, pc)| (b.union(*pb), c.union(*pc)))
     } else {
         one(prims)
-    };
-    (b.aabb(), c.aabb())
+    }
 }
 
-/// Builds the subtree over `prims` (slots `first..first + prims.len()`), appending its
-/// nodes depth-first to `nodes`; node offsets are relative to the start of `nodes`.
-fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<Node>, limits: Limits) {
+/// Builds the subtree over `prims` (slots `first..first + prims.len()`), whose bounds and
+/// centroid bounds are `bounds` and `cb`, appending its nodes depth-first to `nodes`;
+/// node offsets are relative to the start of `nodes`.
+///
+/// A node's bounds come from its parent: the union of the bins on its side of the split
+/// (the same set of primitive boxes), and its centroid bounds from the partition, which
+/// computes every centroid anyway. Minima and maxima are exact, so these are the values a
+/// pass over the child's primitives would give (up to the sign of a zero, which depends
+/// on the order), without that pass.
+fn build_node(
+    prims: &mut [BuildPrim],
+    bounds: Box3A,
+    cb: Box3A,
+    first: u32,
+    depth: u32,
+    nodes: &mut Vec<Node>,
+    limits: Limits,
+) {
     let n = prims.len();
-    let (bounds, cb) = node_bounds(prims, limits.threshold);
     let me = nodes.len();
-    nodes.push(Node::new(bounds, first, n as u16));
+    nodes.push(Node::new(bounds.aabb(), first, n as u16));
     if n == 1 {
         return;
     }
 
-    let extent = cb.diagonal();
+    let extent = cb.max - cb.min;
     // Too deep for the traversal stack if SAH keeps peeling: fall back to median splits,
     // which finish in ceil(log2 n) more levels.
     let force_median = depth + ceil_log2(n) + 2 >= limits.max_depth;
-    let mut split: Option<(usize, usize)> = None; // (axis, last bin on the left)
+    // (axis, last bin on the left, the children's bounds)
+    let mut split: Option<(usize, usize, Box3A, Box3A)> = None;
     if !force_median {
-        let mut scale = [0.0f32; 3];
+        let mut scale = Vec3A::ZERO;
         for a in 0..3 {
             if extent[a] > 0.0 {
                 scale[a] = BINS as f32 / extent[a];
             }
         }
-        let bins = if n > limits.threshold {
+        let mut bins = EMPTY_BINS;
+        if n > limits.threshold {
             // Fixed chunks, merged in order: the same bins for any thread count.
             let parts: Vec<Bins> = prims
                 .par_chunks(BIN_CHUNK)
@@ -209,7 +255,6 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
                     b
                 })
                 .collect();
-            let mut bins = EMPTY_BINS;
             for part in &parts {
                 for a in 0..3 {
                     for i in 0..BINS {
@@ -218,38 +263,47 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
                     }
                 }
             }
-            bins
         } else {
-            let mut bins = EMPTY_BINS;
             fill_bins(&mut bins, prims, cb.min, scale);
-            bins
-        };
+        }
         let mut best_cost = f32::INFINITY;
+        let mut best = None;
         for a in 0..3 {
             if !(extent[a] > 0.0) {
                 continue;
             }
-            // Right-to-left sweep: area * count of the right part for each split.
+            // Only the occupied bins: between two of them every split position leaves
+            // the same primitives on each side, so its cost is the same and the first
+            // position (the occupied bin itself) is the one the strict `<` below keeps.
+            // The costs are those of a sweep over all bins, bit for bit (an empty bin's
+            // box leaves a union unchanged).
+            let mut occupied = [0u8; BINS];
+            let mut m = 0;
+            for (i, bin) in bins[a].iter().enumerate() {
+                occupied[m] = i as u8;
+                m += (bin.count > 0) as usize;
+            }
+            let occupied = &occupied[..m];
+            // Right-to-left sweep: area * count of the part right of each occupied bin.
             let mut right = [0.0f32; BINS];
             let mut rb = Box3A::EMPTY;
             let mut rc = 0u32;
-            for i in (1..BINS).rev() {
-                rb = rb.union(bins[a][i].bounds);
-                rc += bins[a][i].count;
-                right[i - 1] = rb.aabb().surface_area() * rc as f32;
+            for k in (1..m).rev() {
+                let bin = &bins[a][occupied[k] as usize];
+                rb = rb.union(bin.bounds);
+                rc += bin.count;
+                right[k - 1] = rb.surface_area() * rc as f32;
             }
             let mut lb = Box3A::EMPTY;
             let mut lc = 0u32;
-            for i in 0..BINS - 1 {
-                lb = lb.union(bins[a][i].bounds);
-                lc += bins[a][i].count;
-                if lc == 0 || lc as usize == n {
-                    continue;
-                }
-                let cost = lb.aabb().surface_area() * lc as f32 + right[i];
+            for k in 0..m.saturating_sub(1) {
+                let bin = &bins[a][occupied[k] as usize];
+                lb = lb.union(bin.bounds);
+                lc += bin.count;
+                let cost = lb.surface_area() * lc as f32 + right[k];
                 if cost < best_cost {
                     best_cost = cost;
-                    split = Some((a, i));
+                    best = Some((a, occupied[k] as usize));
                 }
             }
         }
@@ -258,17 +312,21 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
         if n <= MAX_LEAF && (n as f32) <= split_cost {
             return;
         }
-        if split.is_none() && n <= MAX_LEAF {
+        if best.is_none() && n <= MAX_LEAF {
             return;
         }
+        split = best.map(|(a, last)| {
+            let side = |bins: &[Bin]| bins.iter().fold(Box3A::EMPTY, |b, bin| b.union(bin.bounds));
+            (a, last, side(&bins[a][..=last]), side(&bins[a][last + 1..]))
+        });
     } else if n <= MAX_LEAF {
         return;
     }
 
-    let (mid, axis) = match split {
-        Some((a, last)) => {
-            let (lo, scale) = (cb.min[a], BINS as f32 / extent[a]);
-            (partition(prims, |p| bin_of(p.centroid()[a], lo, scale) <= last), a)
+    let (mid, axis, (lb, lcb), (rb, rcb)) = match split {
+        Some((a, last, lb, rb)) => {
+            let (mid, lcb, rcb) = partition(prims, a, cb.min[a], BINS as f32 / extent[a], last);
+            (mid, a, (lb, lcb), (rb, rcb))
         }
         None => {
             // Median split on the widest centroid axis, ties broken by index.
@@ -283,7 +341,7 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
             prims.select_nth_unstable_by(mid, |p, q| {
                 p.centroid()[a].total_cmp(&q.centroid()[a]).then(p.index().cmp(&q.index()))
             });
-            (mid, a)
+            (mid, a, node_bounds(&prims[..mid], limits.threshold), node_bounds(&prims[mid..], limits.threshold))
         }
     };
     let (left, right) = prims.split_at_mut(mid);
@@ -291,10 +349,10 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
         // The left subtree goes straight into `nodes` (it comes first depth-first), the
         // right one into its own vector, appended after: one copy of half the nodes.
         let ((), rn) = rayon::join(
-            || build_node(left, first, depth + 1, nodes, limits),
+            || build_node(left, lb, lcb, first, depth + 1, nodes, limits),
             || {
                 let mut v = Vec::with_capacity(right.len() * 2 / 3 + 1);
-                build_node(right, first + mid as u32, depth + 1, &mut v, limits);
+                build_node(right, rb, rcb, first + mid as u32, depth + 1, &mut v, limits);
                 v
             },
         );
@@ -302,9 +360,9 @@ fn build_node(prims: &mut [BuildPrim], first: u32, depth: u32, nodes: &mut Vec<N
         append(nodes, rn);
         second
     } else {
-        build_node(left, first, depth + 1, nodes, limits);
+        build_node(left, lb, lcb, first, depth + 1, nodes, limits);
         let second = nodes.len();
-        build_node(right, first + mid as u32, depth + 1, nodes, limits);
+        build_node(right, rb, rcb, first + mid as u32, depth + 1, nodes, limits);
         second
     };
     let node = &mut nodes[me];
@@ -324,23 +382,123 @@ fn append(nodes: &mut Vec<Node>, sub: Vec<Node>) {
     }));
 }
 
-/// Stable-in-outcome, in-place two-way partition; returns the number of elements for
-/// which `left` holds (they come first).
-fn partition(prims: &mut [BuildPrim], left: impl Fn(&BuildPrim) -> bool) -> usize {
+/// In-place two-way partition of `prims` by centroid bin on `axis` (bins up to `last`
+/// first; deterministic, not stable); returns the number on the left and the centroid
+/// bounds of each side.
+fn partition(prims: &mut [BuildPrim], axis: usize, lo: f32, scale: f32, last: usize) -> (usize, Box3A, Box3A) {
+    let left = |c: Vec3A| bin_of(c[axis], lo, scale) <= last;
+    let (mut lcb, mut rcb) = (Box3A::EMPTY, Box3A::EMPTY);
     let mut i = 0;
     let mut j = prims.len();
     loop {
-        while i < j && left(&prims[i]) {
+        while i < j {
+            let c = prims[i].centroid();
+            if !left(c) {
+                break;
+            }
+            lcb = lcb.grow(c);
             i += 1;
         }
-        while i < j && !left(&prims[j - 1]) {
+        while i < j {
+            let c = prims[j - 1].centroid();
+            if left(c) {
+                break;
+            }
+            rcb = rcb.grow(c);
             j -= 1;
         }
         if i >= j {
-            return i;
+            return (i, lcb, rcb);
         }
+        // `prims[i]` belongs right and `prims[j - 1]` left.
+        lcb = lcb.grow(prims[j - 1].centroid());
+        rcb = rcb.grow(prims[i].centroid());
         prims.swap(i, j - 1);
         i += 1;
         j -= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::bvh::tests::soup;
+    use glam::Vec3;
+
+    /// Every value class the binning can meet: NaN, infinities, negative values, both
+    /// zeros, the bin edges and just below them, and past the last bin.
+    const VALUES: [f32; 14] = [
+        f32::NAN,
+        f32::NEG_INFINITY,
+        -1.0,
+        -0.0,
+        0.0,
+        1e-40,
+        0.999_999_9,
+        1.0,
+        7.5,
+        14.999_999,
+        15.0,
+        16.0,
+        1e30,
+        f32::INFINITY,
+    ];
+
+    #[test]
+    fn bins_of_three_axes_is_bin_of_on_each() {
+        for &c in &VALUES {
+            for &lo in &[0.0f32, -0.0, 1.0, f32::INFINITY] {
+                for &scale in &[0.0f32, 1.0, 3.2, f32::INFINITY] {
+                    let v = Vec3A::new(c, -c, c * 0.5);
+                    let got = bins_of(v, Vec3A::splat(lo), Vec3A::splat(scale));
+                    let want = [0, 1, 2].map(|a| bin_of(v[a], lo, scale));
+                    assert_eq!(got, want, "c {v} lo {lo} scale {scale}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn simd_surface_area_is_the_aabbs_bit_for_bit() {
+        let soup = soup(500, 11);
+        let mut boxes: Vec<Aabb> = soup.iter().map(|t| t.bounds()).collect();
+        boxes.push(Aabb::EMPTY);
+        boxes.push(Aabb { min: Vec3::new(0.0, f32::NAN, 0.0), max: Vec3::ONE });
+        boxes.push(Aabb { min: Vec3::ZERO, max: Vec3::new(1.0, 0.0, 2.0) }); // flat
+        boxes.push(Aabb { min: Vec3::ZERO, max: Vec3::new(1.0, -1.0, 2.0) }); // inverted on y
+        boxes.push(Aabb { min: Vec3::splat(-1e30), max: Vec3::splat(1e30) }); // area overflows
+        for b in boxes {
+            let simd = Box3A { min: b.min.into(), max: b.max.into() };
+            assert_eq!(simd.surface_area().to_bits(), b.surface_area().to_bits(), "{b:?}");
+        }
+    }
+
+    /// A node's box comes from its parent's bins, and its centroid bounds from the
+    /// parent's partition; checked here against a fold over the node's own primitives.
+    #[test]
+    fn every_node_box_is_the_tight_box_of_its_primitives() {
+        let mut boxes: Vec<Aabb> = soup(6000, 12).iter().map(|t| t.bounds()).collect();
+        // Shared coordinates and zeros of both signs, where the order of a fold shows.
+        for (i, b) in boxes.iter_mut().enumerate().step_by(7) {
+            b.min.x = if i % 2 == 0 { 0.0 } else { -0.0 };
+            b.max.y = b.max.y.max(1.0);
+        }
+        for threshold in [64, usize::MAX] {
+            let limits = Limits { threshold, join: threshold, max_depth: 40 };
+            let (nodes, order) = build_tree(boxes.len(), |i| boxes[i], limits);
+            // Slot range of node `i`: a leaf's own, an interior node's from its children.
+            fn range(nodes: &[Node], i: usize) -> (u32, u32) {
+                let n = &nodes[i];
+                if n.count > 0 {
+                    return (n.offset, n.offset + n.count as u32);
+                }
+                (range(nodes, i + 1).0, range(nodes, n.offset as usize).1)
+            }
+            for (i, node) in nodes.iter().enumerate() {
+                let (a, b) = range(&nodes, i);
+                let tight = order[a as usize..b as usize].iter().fold(Aabb::EMPTY, |u, &k| u.union(&boxes[k as usize]));
+                assert_eq!(node.aabb(), tight, "node {i} (slots {a}..{b}), threshold {threshold}");
+            }
+        }
     }
 }
