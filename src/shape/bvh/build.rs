@@ -24,8 +24,9 @@ use crate::geometry::Aabb;
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
-/// Number of SAH bins per axis.
+/// Number of SAH bins per axis (a power of two: see `fill_bins`).
 const BINS: usize = 16;
+const _: () = assert!(BINS.is_power_of_two());
 /// Largest leaf the SAH may choose.
 const MAX_LEAF: usize = 8;
 /// SAH cost of visiting a node, relative to intersecting one primitive, for the build:
@@ -165,13 +166,14 @@ type Bins = [[Bin; BINS]; 3];
 
 const EMPTY_BINS: Bins = [[Bin { bounds: Box3A::EMPTY, count: 0 }; BINS]; 3];
 
-/// Bin of centroid coordinate `c` on one axis (partitioning).
-#[inline(always)]
+/// Bin of centroid coordinate `c` on one axis: the definition that [`bins_of`] (binning)
+/// and [`Side`] (partitioning) compute without it, tested against it.
+#[cfg(test)]
 fn bin_of(c: f32, lo: f32, scale: f32) -> usize {
     (((c - lo) * scale) as usize).min(BINS - 1)
 }
 
-/// [`bin_of`] on the three axes at once (binning): the same products lane by lane, and
+/// `bin_of` on the three axes at once (binning): the same products lane by lane, and
 /// the same index for every value, NaN included: `max` with 0 gives 0 for NaN and for
 /// negative values as the saturating `as usize` does, `min` the last bin.
 #[inline(always)]
@@ -186,7 +188,8 @@ fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3A, scale: Vec3A) {
         let b = p.bounds();
         let i = bins_of((b.min + b.max) * 0.5, lo, scale);
         for a in 0..3 {
-            let bin = &mut bins[a][i[a]];
+            // (`i[a] <= BINS - 1` already; the mask lets the compiler drop the bounds check.)
+            let bin = &mut bins[a][i[a] & (BINS - 1)];
             bin.count += 1;
             bin.bounds = bin.bounds.union(b);
         }
@@ -382,11 +385,38 @@ fn append(nodes: &mut Vec<Node>, sub: Vec<Node>) {
     }));
 }
 
+/// Which side of a split a centroid falls on: `bin_of(c[axis], lo, scale) <= last`,
+/// without the conversion to an integer. For `last < BINS - 1`, `trunc(x) <= last` is
+/// `x < last + 1` for every `x >= 0`; `x` below 0 and NaN go to bin 0, on the left, and
+/// `!(x >= last + 1)` holds for them too (tested against `bin_of`).
+#[derive(Clone, Copy)]
+struct Side {
+    lo: Vec3A,
+    scale: Vec3A,
+    bound: Vec3A,
+    axis: u32,
+}
+
+impl Side {
+    fn new(axis: usize, lo: f32, scale: f32, last: usize) -> Side {
+        debug_assert!(last < BINS - 1);
+        let bound = Vec3A::splat((last + 1) as f32);
+        Side { lo: Vec3A::splat(lo), scale: Vec3A::splat(scale), bound, axis: axis as u32 }
+    }
+
+    /// True if centroid `c` goes left (every lane is computed, lane `axis` decides).
+    #[inline(always)]
+    fn left(&self, c: Vec3A) -> bool {
+        ((c - self.lo) * self.scale).cmpge(self.bound).bitmask() >> self.axis & 1 == 0
+    }
+}
+
 /// In-place two-way partition of `prims` by centroid bin on `axis` (bins up to `last`
 /// first; deterministic, not stable); returns the number on the left and the centroid
 /// bounds of each side.
 fn partition(prims: &mut [BuildPrim], axis: usize, lo: f32, scale: f32, last: usize) -> (usize, Box3A, Box3A) {
-    let left = |c: Vec3A| bin_of(c[axis], lo, scale) <= last;
+    let side = Side::new(axis, lo, scale, last);
+    let left = |c: Vec3A| side.left(c);
     let (mut lcb, mut rcb) = (Box3A::EMPTY, Box3A::EMPTY);
     let mut i = 0;
     let mut j = prims.len();
@@ -453,6 +483,25 @@ mod tests {
                     let got = bins_of(v, Vec3A::splat(lo), Vec3A::splat(scale));
                     let want = [0, 1, 2].map(|a| bin_of(v[a], lo, scale));
                     assert_eq!(got, want, "c {v} lo {lo} scale {scale}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn partition_side_is_bin_of_compared_with_last() {
+        for &x in &VALUES {
+            for &lo in &[0.0f32, -0.0, 1.0, f32::INFINITY] {
+                for &scale in &[0.0f32, 1.0, 3.2, f32::INFINITY] {
+                    for last in 0..BINS - 1 {
+                        for axis in 0..3 {
+                            let mut c = Vec3A::splat(f32::NAN);
+                            c[axis] = x;
+                            let want = bin_of(x, lo, scale) <= last;
+                            let got = Side::new(axis, lo, scale, last).left(c);
+                            assert_eq!(got, want, "x {x} lo {lo} scale {scale} last {last} axis {axis}");
+                        }
+                    }
                 }
             }
         }
