@@ -46,6 +46,10 @@ pub(super) struct Limits {
     /// The tree's depth stays below this (levels of nodes, the root is level 0): nodes
     /// that the SAH would take deeper are split at the median instead.
     pub max_depth: u32,
+    /// Nodes of at most this many primitives become leaves without a split (at least 1).
+    /// The wide tree passes its leaf size: it tests all of a leaf's triangles, so the
+    /// splits below that size would only order them inside the leaf.
+    pub leaf: usize,
 }
 
 /// A box in SIMD registers (glam's `Vec3A`: one SSE register per corner), so that a union
@@ -230,7 +234,7 @@ fn build_node(
     let n = prims.len();
     let me = nodes.len();
     nodes.push(Node::new(bounds.aabb(), first, n as u16));
-    if n == 1 {
+    if n <= limits.leaf {
         return;
     }
 
@@ -533,7 +537,7 @@ mod tests {
             b.max.y = b.max.y.max(1.0);
         }
         for threshold in [64, usize::MAX] {
-            let limits = Limits { threshold, join: threshold, max_depth: 40 };
+            let limits = Limits { threshold, join: threshold, max_depth: 40, leaf: 1 };
             let (nodes, order) = build_tree(boxes.len(), |i| boxes[i], limits);
             // Slot range of node `i`: a leaf's own, an interior node's from its children.
             fn range(nodes: &[Node], i: usize) -> (u32, u32) {

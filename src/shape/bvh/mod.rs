@@ -150,8 +150,11 @@ impl Bvh {
     }
 
     fn build_with(prim_bounds: &[Aabb], threshold: usize, join: usize) -> Bvh {
-        let (nodes, order) =
-            build_tree(prim_bounds.len(), |i| prim_bounds[i], Limits { threshold, join, max_depth: STACK as u32 });
+        let (nodes, order) = build_tree(
+            prim_bounds.len(),
+            |i| prim_bounds[i],
+            Limits { threshold, join, max_depth: STACK as u32, leaf: 1 },
+        );
         Bvh { nodes, order }
     }
 

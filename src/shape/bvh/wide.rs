@@ -6,11 +6,14 @@
 //! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
 //! grandchildren (or, beside a leaf child, its other child's children, then the children
 //! of the largest of those), and a subtree of at most [`LEAF_TRIANGLES`] triangles becomes
-//! one leaf of up to three blocks. Leaves keep the binary tree's slot order, so the
-//! triangles' storage order (and `Hit::prim`) is the binary tree's; the tree is as
-//! deterministic as that build. The collapse writes the nodes and places the blocks; the
-//! blocks' vertices are gathered after, in parallel. Every child a ray is about to visit is prefetched, and
-//! the node and block arrays are advised into huge pages (`hint.rs`).
+//! one leaf of up to three blocks. The binary build is told to stop there (`leaf` in its
+//! limits): a leaf's triangles are all tested, so splitting it further would only order
+//! them inside it, and those small nodes were most of the build's nodes. Leaves keep the
+//! binary tree's slot order, so the triangles' storage order (and `Hit::prim`) is the
+//! binary tree's; the tree is as deterministic as that build. The collapse writes the
+//! nodes and places the blocks; the blocks' vertices are gathered after, in parallel.
+//! Every child a ray is about to visit is prefetched, and the node and block arrays are
+//! advised into huge pages (`hint.rs`).
 //!
 //! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
 //! under 32 bytes per triangle, the vertices live in the blocks.
@@ -157,24 +160,38 @@ impl WideBvh {
     /// in parallel above 4k triangles, then collapsed). At most 2^28 - 1 blocks (meshes
     /// check this when they load).
     pub fn build(tris: &[[Vec3; 3]]) -> WideBvh {
-        Self::build_with(tris.len(), |i| tris[i], PARALLEL_THRESHOLD, JOIN_THRESHOLD)
+        Self::build_with(tris.len(), |i| tris[i], PARALLEL_THRESHOLD, JOIN_THRESHOLD, LEAF_TRIANGLES)
     }
 
     /// [`WideBvh::build`] over indexed triangles (`tris[i]` holds three indices into
     /// `positions`, all in range), without an array of their vertices.
     pub fn build_indexed(positions: &[Vec3], tris: &[[u32; 3]]) -> WideBvh {
-        Self::build_with(tris.len(), |i| tris[i].map(|v| positions[v as usize]), PARALLEL_THRESHOLD, JOIN_THRESHOLD)
+        Self::build_with(
+            tris.len(),
+            |i| tris[i].map(|v| positions[v as usize]),
+            PARALLEL_THRESHOLD,
+            JOIN_THRESHOLD,
+            LEAF_TRIANGLES,
+        )
     }
 
     /// With both thresholds equal (tests: small to be parallel everywhere, `usize::MAX`
     /// for a serial build).
     #[cfg(test)]
     fn build_with_threshold(tris: &[[Vec3; 3]], threshold: usize) -> WideBvh {
-        Self::build_with(tris.len(), |i| tris[i], threshold, threshold)
+        Self::build_with(tris.len(), |i| tris[i], threshold, threshold, LEAF_TRIANGLES)
     }
 
-    fn build_with(n: usize, tri: impl Fn(usize) -> [Vec3; 3] + Sync, threshold: usize, join: usize) -> WideBvh {
-        let limits = Limits { threshold, join, max_depth: BINARY_DEPTH };
+    /// `leaf`: binary subtrees of at most this many triangles are not split (the wide
+    /// tree's leaf size; 1 in a test builds the whole binary tree, as before).
+    fn build_with(
+        n: usize,
+        tri: impl Fn(usize) -> [Vec3; 3] + Sync,
+        threshold: usize,
+        join: usize,
+        leaf: u32,
+    ) -> WideBvh {
+        let limits = Limits { threshold, join, max_depth: BINARY_DEPTH, leaf: leaf as usize };
         let (bin, order) = build_tree(
             n,
             |i| {
@@ -626,12 +643,41 @@ mod tests {
     }
 
     #[test]
-    fn same_slot_order_as_the_binary_tree_and_deterministic() {
+    fn same_tree_as_the_whole_binary_tree_and_deterministic() {
         let tris = soup(5000, 3);
         let v = verts(&tris);
         let reference = WideBvh::build_with_threshold(&v, 64);
+        // Built from the whole binary tree (no subtree left unsplit), the collapse keeps
+        // the binary tree's slot order...
+        let whole = WideBvh::build_with(v.len(), |i| v[i], 64, 64, 1);
         let binary = super::super::Bvh::build(&tris.iter().map(|t| t.bounds()).collect::<Vec<_>>());
-        assert_eq!(reference.order, binary.prim_order(), "storage order unchanged by the collapse");
+        assert_eq!(whole.order, binary.prim_order(), "storage order unchanged by the collapse");
+        // ...and the tree that stops splitting at the leaf size has the same nodes and
+        // leaves, holding the same triangles, only in another order inside each leaf.
+        assert_eq!(
+            (&reference.nodes, &reference.block_first, reference.root),
+            (&whole.nodes, &whole.block_first, whole.root)
+        );
+        let mut leaves = 0;
+        for r in reference
+            .nodes
+            .iter()
+            .flat_map(|n| n.child)
+            .chain([reference.root])
+            .filter(|&r| r != EMPTY && r & LEAF != 0)
+        {
+            let (first, nb) = ((r & BLOCK_MASK) as usize, ((r >> 28) & 7) as usize + 1);
+            let a = reference.block_first[first] as usize;
+            let b = reference.block_first.get(first + nb).map_or(reference.order.len(), |&x| x as usize);
+            let sorted = |o: &[u32]| {
+                let mut o = o.to_vec();
+                o.sort();
+                o
+            };
+            assert_eq!(sorted(&reference.order[a..b]), sorted(&whole.order[a..b]), "leaf at slots {a}..{b}");
+            leaves += 1;
+        }
+        assert!(leaves > 400 && reference.order != whole.order, "{leaves} leaves");
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let t = pool.install(|| WideBvh::build_with_threshold(&v, 64));
