@@ -75,7 +75,9 @@ fn prefetch(p: *const u8) {
 /// (Linux 6.1 and later: the pages already there are merged now, their contents kept).
 /// A hint only: failures (an older kernel, huge pages disabled, no free 2 MiB page) are
 /// ignored, and a slice shorter than one aligned 2 MiB span is left alone. Returns the
-/// number of bytes advised.
+/// number of bytes advised. `data` may be a vector's spare capacity
+/// (`Vec::spare_capacity_mut`, not yet written): pages first touched after the advice are
+/// mapped as huge pages directly, which is cheaper than merging them later.
 pub(super) fn advise_huge_pages<T>(data: &[T]) -> usize {
     const HUGE: usize = 2 << 20;
     let start = data.as_ptr() as usize;

@@ -230,7 +230,7 @@ impl WideBvh {
         }
         drop((bin, range));
         // The blocks, filled in parallel in their final order (the collapse above only
-        // placed them): gathering the vertices is most of the collapse's time.
+        // placed them): gathering the vertices was about half of the collapse's time.
         let mut blocks = Vec::with_capacity(lanes.len());
         advise_huge_pages(blocks.spare_capacity_mut());
         let fill = |b: usize| {
