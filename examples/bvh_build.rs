@@ -12,6 +12,7 @@
 //! ```
 
 use rust_v::geometry::Aabb;
+use rust_v::io::Fnv1a;
 use rust_v::shape::{Bvh, Mesh, WideBvh};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -47,8 +48,11 @@ fn main() {
     } else {
         Vec::new()
     };
+    // FNV-1a (the crate's one hash) of the slot order as little-endian u32s.
     let fnv = |order: &[u32]| {
-        order.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x as u64).wrapping_mul(0x100_0000_01b3))
+        let mut h = Fnv1a::default();
+        order.iter().for_each(|k| h.write(&k.to_le_bytes()));
+        h.finish()
     };
     // The process's huge pages while the first tree is alive.
     let huge = || {

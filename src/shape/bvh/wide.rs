@@ -223,29 +223,31 @@ impl WideBvh {
         // left to merge. Merging 4 KiB pages already written took 15-45 ms of a 0.35 s
         // build of the full dragon.
         advise_huge_pages(w.nodes.spare_capacity_mut());
-        let mut lanes = Vec::with_capacity(n / 2 + 1);
         if !bin.is_empty() {
-            let mut c = Collapse { bin: &bin, range: &range, out: &mut w, lanes: &mut lanes };
+            let mut c = Collapse { bin: &bin, range: &range, out: &mut w };
             w.root = c.subtree(0);
         }
         drop((bin, range));
         // The blocks, filled in parallel in their final order (the collapse above only
         // placed them): gathering the vertices was about half of the collapse's time.
-        let mut blocks = Vec::with_capacity(lanes.len());
+        // Blocks follow each other in slot order, so a block's triangles run up to the
+        // next block's first slot.
+        let nb = w.block_first.len();
+        let mut blocks = Vec::with_capacity(nb);
         advise_huge_pages(blocks.spare_capacity_mut());
         let fill = |b: usize| {
             let first = w.block_first[b] as usize;
+            let end = w.block_first.get(b + 1).map_or(n, |&x| x as usize);
             let mut v = [[Vec3::ZERO; 3]; 4];
-            let n = lanes[b] as usize;
-            for (k, lane) in v[..n].iter_mut().enumerate() {
-                *lane = tri(order[first + k] as usize);
+            for (lane, &k) in v.iter_mut().zip(&order[first..end]) {
+                *lane = tri(k as usize);
             }
-            Tri4::new(&v[..n])
+            Tri4::new(&v[..end - first])
         };
         if n > threshold {
-            (0..lanes.len()).into_par_iter().with_min_len(1024).map(fill).collect_into_vec(&mut blocks);
+            (0..nb).into_par_iter().with_min_len(1024).map(fill).collect_into_vec(&mut blocks);
         } else {
-            blocks.extend((0..lanes.len()).map(fill));
+            blocks.extend((0..nb).map(fill));
         }
         w.blocks = blocks;
         w.order = order;
@@ -451,14 +453,11 @@ impl WideBvh {
 }
 
 /// State of the collapse of a binary tree into [`WideBvh`] nodes: it writes the nodes and
-/// places the blocks (their first slots and lane counts); the blocks' vertices are
-/// gathered after.
+/// places the blocks (their first slots); the blocks' vertices are gathered after.
 struct Collapse<'a> {
     bin: &'a [Node],
     range: &'a [(u32, u32)],
     out: &'a mut WideBvh,
-    /// Triangles in each block.
-    lanes: &'a mut Vec<u8>,
 }
 
 impl Collapse<'_> {
@@ -471,12 +470,9 @@ impl Collapse<'_> {
     fn subtree(&mut self, i: usize) -> u32 {
         let (first, count) = self.range[i];
         if !self.opens(i) {
-            let start = self.lanes.len();
-            for j in (first..first + count).step_by(4) {
-                self.lanes.push((first + count - j).min(4) as u8);
-                self.out.block_first.push(j);
-            }
-            let nb = (self.lanes.len() - start) as u32;
+            let start = self.out.block_first.len();
+            self.out.block_first.extend((first..first + count).step_by(4));
+            let nb = (self.out.block_first.len() - start) as u32;
             debug_assert!((1..=8).contains(&nb) && start < MAX_BLOCKS);
             return LEAF | (nb - 1) << 28 | start as u32;
         }
