@@ -1,5 +1,5 @@
 //! BVH benchmark on the full Stanford dragon (871,414 triangles): load time, build
-//! time of the mesh's 4-wide BVH (and of a whole binary `Bvh` over the same boxes, which
+//! time of the mesh's 8-wide BVH (and of a whole binary `Bvh` over the same boxes, which
 //! splits down to single triangles where the wide build stops at 12) on 1 and
 //! 2 threads, memory per triangle, SAH cost, and single-thread closest-hit throughput
 //! for coherent primary rays and incoherent random rays.
@@ -113,7 +113,7 @@ fn main() {
     println!("| BVH build, 1 thread (median/5)   | {:>9.3} s  |", build1.as_secs_f64());
     println!("| BVH build, 2 threads (median/5)  | {:>9.3} s  |", build2.as_secs_f64());
     println!("| whole binary Bvh, 1 / 2 threads | {:.3} / {:.3} s |", binary1.as_secs_f64(), binary2.as_secs_f64());
-    println!("| 4-wide nodes (128 B)             | {:>12} |", mb.node_count());
+    println!("| 8-wide nodes (256 B)             | {:>12} |", mb.node_count());
     println!(
         "| 4-triangle blocks (144 B)        | {:>12} | ({:.0}% of lanes used)",
         mb.block_count(),

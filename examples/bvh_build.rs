@@ -1,4 +1,4 @@
-//! Times the mesh BVH's build on its own: reads a mesh once, then builds its 4-wide BVH
+//! Times the mesh BVH's build on its own: reads a mesh once, then builds its 8-wide BVH
 //! (or, with `--binary`, a whole binary `Bvh` over the triangles' boxes) `--builds`
 //! times in one process on a pool of `--threads` threads, and prints the median and every
 //! time. The first build's fingerprint (node and block counts, the SAH cost's bits, a

@@ -19,12 +19,14 @@
 //! arrives). Off Linux or off x86-64 the functions do nothing.
 #![allow(unsafe_code)]
 
-/// Requests the cache line holding `p` and the one after it (a 128-byte node).
+/// Requests the cache lines of the value of `T` at `p`, a node aligned to 64 bytes (two
+/// lines for a 128-byte node, four for the mesh tree's 256-byte node).
 #[inline(always)]
 pub(super) fn prefetch_node<T>(p: *const T) {
     let p = p.cast::<u8>();
-    prefetch(p);
-    prefetch(p.wrapping_add(64));
+    for line in 0..size_of::<T>().div_ceil(64) {
+        prefetch(p.wrapping_add(64 * line));
+    }
 }
 
 /// Requests the cache line holding `p` (an index entry read once the traversal ends).

@@ -9,7 +9,7 @@
 //! to indices in the slice the tree was built from. Scenes use it over their shapes.
 //!
 //! Meshes use [`WideBvh`] instead (`wide.rs`): the same build (`build.rs`), stopped at
-//! subtrees of 12 triangles and collapsed into 4-wide nodes whose leaves hold the
+//! subtrees of 12 triangles and collapsed into 8-wide nodes whose leaves hold the
 //! triangles themselves, four to a block (`tri4.rs`), in that build's slot order.
 
 // `!(x > 0.0)` is used on purpose: it is also true for NaN.

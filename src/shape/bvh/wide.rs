@@ -1,28 +1,29 @@
-//! The triangle BVH of meshes: 4-wide nodes of one 128-byte, cache-line-aligned block
-//! (the four children's boxes as `[min/max][axis][lane]` arrays of `f32`, then the four
+//! The triangle BVH of meshes: 8-wide nodes of one 256-byte, cache-line-aligned block
+//! (the eight children's boxes as `[min/max][axis][lane]` arrays of `f32`, then the eight
 //! child references), leaves of [`Tri4`] blocks, closest-hit traversal that enters the
 //! nearest child first, and any-hit traversal for shadow rays.
 //!
 //! It is built by collapsing the binary SAH tree of [`super::build`]: a node takes its
-//! grandchildren (or, beside a leaf child, its other child's children, then the children
-//! of the largest of those), and a subtree of at most [`LEAF_TRIANGLES`] triangles becomes
-//! one leaf of up to three blocks. The binary build is told to stop there (`leaf` in its
-//! limits): a leaf's triangles are all tested, so splitting it further would only order
-//! them inside it, and those small nodes were most of the build's nodes. Leaves keep the
-//! binary tree's slot order, so the triangles' storage order (and `Hit::prim`) is the
-//! binary tree's; the tree is as deterministic as that build. The collapse writes the
-//! nodes and places the blocks; the blocks' vertices are gathered after, in parallel.
-//! Every child a ray is about to visit is prefetched, and the node and block arrays are
-//! advised into huge pages (`hint.rs`).
+//! grandchildren (a leaf child stays as it is), then keeps replacing the child with the
+//! largest box that can open by that child's two children, until it has [`W`]; a subtree
+//! of at most [`LEAF_TRIANGLES`] triangles becomes one leaf of up to three blocks. The
+//! binary build is told to stop there (`leaf` in its limits): a leaf's triangles are all
+//! tested, so splitting it further would only order them inside it, and those small nodes
+//! were most of the build's nodes. Children stay in slot order and leaves keep the binary
+//! tree's slot order, so the triangles' storage order (and `Hit::prim`) is the binary
+//! tree's; the tree is as deterministic as that build. The collapse writes the nodes and
+//! places the blocks; the blocks' vertices are gathered after, in parallel. Every child a
+//! ray is about to visit is prefetched, and the node and block arrays are advised into
+//! huge pages (`hint.rs`).
 //!
 //! Memory (full Stanford dragon): see `docs/performance.md`; nodes and index data stay
 //! under 32 bytes per triangle, the vertices live in the blocks.
 //!
 //! Traversal stack: every node below the root sits at least two binary levels under its
 //! parent node, so a binary tree of depth below [`BINARY_DEPTH`] gives at most
-//! `BINARY_DEPTH / 2` node levels, and three pending siblings per level fit [`STACK`].
+//! `BINARY_DEPTH / 2` node levels, and `W - 1` pending siblings per level fit [`STACK`].
 
-// Lane loops `for l in 0..4` index several arrays by lane on purpose: that is the form the
+// Lane loops `for l in 0..W` index several arrays by lane on purpose: that is the form the
 // compiler vectorises.
 #![allow(clippy::needless_range_loop)]
 
@@ -35,6 +36,13 @@ use crate::shape::triangle::TriRay;
 use glam::Vec3;
 use rayon::prelude::*;
 
+/// Children per node. Measured against 4 (128-byte nodes; the same leaves, so the same
+/// hits bit for bit) on the full dragon, in one process, alternating passes: incoherent
+/// rays +12% and +16%, primary rays +1% (docs/performance.md, round 8). On a CPU with
+/// AVX an 8-lane box test is as many instructions as a 4-lane one, and a ray visits fewer
+/// nodes (SAH cost 19.8 against 25.7). Round 2 measured 8-wide nodes as no faster on the
+/// SSE2 baseline with leaves of one block.
+const W: usize = 8;
 /// Depth limit of the binary tree that is collapsed (see the module doc).
 const BINARY_DEPTH: u32 = 42;
 /// Largest binary subtree that becomes a leaf (three full blocks). Measured on the full
@@ -45,8 +53,8 @@ const BINARY_DEPTH: u32 = 42;
 /// visit costs more than the SAH's unit here: it is a dependent cache miss, while a
 /// leaf's blocks are contiguous and fetched together.
 const LEAF_TRIANGLES: u32 = 12;
-/// Traversal stack entries: three pending children per node level, plus one.
-const STACK: usize = 3 * (BINARY_DEPTH as usize / 2) + 1;
+/// Traversal stack entries: `W - 1` pending children per node level, plus one.
+const STACK: usize = (W - 1) * (BINARY_DEPTH as usize / 2) + 1;
 /// Reference flag of a leaf; its bits 28-30 hold the block count minus one and bits
 /// 0-27 the first block.
 const LEAF: u32 = 1 << 31;
@@ -57,19 +65,19 @@ const EMPTY: u32 = u32::MAX;
 /// Most blocks a mesh can have (the rest of a reference's bits).
 pub(crate) const MAX_BLOCKS: usize = BLOCK_MASK as usize;
 
-/// Four children: boxes as `b[0 = min, 1 = max][axis][lane]`, then their references
+/// [`W`] children: boxes as `b[0 = min, 1 = max][axis][lane]`, then their references
 /// (a node index, a leaf, or [`EMPTY`] with an empty box).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-struct Node4 {
-    b: [[[f32; 4]; 3]; 2],
-    child: [u32; 4],
+struct WideNode {
+    b: [[[f32; W]; 3]; 2],
+    child: [u32; W],
 }
 
-const _: () = assert!(std::mem::size_of::<Node4>() == 128 && std::mem::size_of::<Tri4>() == 144);
+const _: () = assert!(std::mem::size_of::<WideNode>() == 256 && std::mem::size_of::<Tri4>() == 144);
 
-impl Node4 {
-    const EMPTY: Node4 = Node4 { b: [[[f32::INFINITY; 4]; 3], [[f32::NEG_INFINITY; 4]; 3]], child: [EMPTY; 4] };
+impl WideNode {
+    const EMPTY: WideNode = WideNode { b: [[[f32::INFINITY; W]; 3], [[f32::NEG_INFINITY; W]; 3]], child: [EMPTY; W] };
 
     fn set(&mut self, lane: usize, bounds: Aabb, child: u32) {
         for a in 0..3 {
@@ -101,10 +109,10 @@ pub struct TriangleHit {
     pub v: [Vec3; 3],
 }
 
-/// A 4-wide BVH that stores its triangles (see the module doc).
+/// An 8-wide BVH that stores its triangles (see the module doc).
 #[derive(Clone, Debug)]
 pub struct WideBvh {
-    nodes: Vec<Node4>,
+    nodes: Vec<WideNode>,
     blocks: Vec<Tri4>,
     /// Slot of each block's lane 0; the other lanes follow.
     block_first: Vec<u32>,
@@ -114,32 +122,32 @@ pub struct WideBvh {
     bounds: Aabb,
 }
 
-/// Per-ray data of the 4-wide slab test.
-struct RayBox4 {
+/// Per-ray data of the wide slab test.
+struct RayBox {
     o: [f32; 3],
     inv: [f32; 3],
     neg: [usize; 3],
 }
 
-impl RayBox4 {
+impl RayBox {
     #[inline(always)]
-    fn new(ray: &Ray) -> RayBox4 {
+    fn new(ray: &Ray) -> RayBox {
         // As in the binary tree: 1/±0 = ±inf, NaN slab values are ignored.
         let inv = (Vec3::ONE / ray.dir).to_array();
-        RayBox4 { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
+        RayBox { o: ray.origin.to_array(), inv, neg: inv.map(|x| (x < 0.0) as usize) }
     }
 
     /// Entry distance into each child's box if the ray hits it with `t` in `[0, t_max]`,
     /// else infinity: the binary tree's slab test, lane by lane.
     #[inline(always)]
-    fn entry(&self, n: &Node4, t_max: f32) -> [f32; 4] {
-        let mut t0 = [0.0f32; 4];
-        let mut t1 = [t_max; 4];
+    fn entry(&self, n: &WideNode, t_max: f32) -> [f32; W] {
+        let mut t0 = [0.0f32; W];
+        let mut t1 = [t_max; W];
         for a in 0..3 {
             let near = &n.b[self.neg[a]][a];
             let far = &n.b[1 - self.neg[a]][a];
             let (o, inv) = (self.o[a], self.inv[a]);
-            for l in 0..4 {
+            for l in 0..W {
                 let ta = (near[l] - o) * inv;
                 let tb = (far[l] - o) * inv * ROBUST;
                 // Written so that a NaN slab value leaves t0/t1 unchanged (maxps/minps).
@@ -147,8 +155,8 @@ impl RayBox4 {
                 t1[l] = if tb < t1[l] { tb } else { t1[l] };
             }
         }
-        let mut e = [f32::INFINITY; 4];
-        for l in 0..4 {
+        let mut e = [f32::INFINITY; W];
+        for l in 0..W {
             e[l] = if t0[l] <= t1[l] { t0[l] } else { f32::INFINITY };
         }
         e
@@ -159,13 +167,13 @@ impl WideBvh {
     /// Builds over triangles given by their vertices (binned SAH on their boxes, subtrees
     /// in parallel above 4k triangles, then collapsed). At most 2^28 - 1 blocks (meshes
     /// check this when they load).
-    pub fn build(tris: &[[Vec3; 3]]) -> WideBvh {
+    pub fn build(tris: &[[Vec3; 3]]) -> Self {
         Self::build_with(tris.len(), |i| tris[i], PARALLEL_THRESHOLD, JOIN_THRESHOLD, LEAF_TRIANGLES)
     }
 
     /// [`WideBvh::build`] over indexed triangles (`tris[i]` holds three indices into
     /// `positions`, all in range), without an array of their vertices.
-    pub fn build_indexed(positions: &[Vec3], tris: &[[u32; 3]]) -> WideBvh {
+    pub fn build_indexed(positions: &[Vec3], tris: &[[u32; 3]]) -> Self {
         Self::build_with(
             tris.len(),
             |i| tris[i].map(|v| positions[v as usize]),
@@ -178,19 +186,13 @@ impl WideBvh {
     /// With both thresholds equal (tests: small to be parallel everywhere, `usize::MAX`
     /// for a serial build).
     #[cfg(test)]
-    fn build_with_threshold(tris: &[[Vec3; 3]], threshold: usize) -> WideBvh {
+    fn build_with_threshold(tris: &[[Vec3; 3]], threshold: usize) -> Self {
         Self::build_with(tris.len(), |i| tris[i], threshold, threshold, LEAF_TRIANGLES)
     }
 
     /// `leaf`: binary subtrees of at most this many triangles are not split (the wide
     /// tree's leaf size; 1 in a test builds the whole binary tree, as before).
-    fn build_with(
-        n: usize,
-        tri: impl Fn(usize) -> [Vec3; 3] + Sync,
-        threshold: usize,
-        join: usize,
-        leaf: u32,
-    ) -> WideBvh {
+    fn build_with(n: usize, tri: impl Fn(usize) -> [Vec3; 3] + Sync, threshold: usize, join: usize, leaf: u32) -> Self {
         let limits = Limits { threshold, join, max_depth: BINARY_DEPTH, leaf: leaf as usize };
         let (bin, order) = build_tree(
             n,
@@ -280,7 +282,7 @@ impl WideBvh {
         self.bounds
     }
 
-    /// Number of 4-wide nodes.
+    /// Number of wide nodes.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
@@ -293,7 +295,7 @@ impl WideBvh {
     /// Bytes of the nodes and the index data (each block's first slot, the slot order);
     /// the vertices are [`WideBvh::triangle_bytes`].
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * size_of::<Node4>() + (self.block_first.len() + self.order.len()) * 4
+        self.nodes.len() * size_of::<WideNode>() + (self.block_first.len() + self.order.len()) * 4
     }
 
     /// Bytes of the triangle blocks (the vertices, unused lanes included).
@@ -318,7 +320,7 @@ impl WideBvh {
         let cost = |r: u32| if r & LEAF == 0 { 1.0 } else { (((r >> 28) & 7) + 1) as f64 };
         let mut total = cost(self.root) * root_area;
         for n in &self.nodes {
-            for l in 0..4 {
+            for l in 0..W {
                 if n.child[l] != EMPTY {
                     total += cost(n.child[l]) * area(n.child_box(l));
                 }
@@ -335,7 +337,7 @@ impl WideBvh {
         if self.root == EMPTY {
             return None;
         }
-        let rb = RayBox4::new(ray);
+        let rb = RayBox::new(ray);
         let tr = TriRay::new(ray);
         let mut t_max = t_max;
         let mut best = None;
@@ -347,9 +349,9 @@ impl WideBvh {
                 let node = &self.nodes[cur as usize];
                 let e = rb.entry(node, t_max);
                 // Hit children, then sorted farthest first: the nearest is visited now.
-                let mut c = [(0.0f32, 0u32); 4];
+                let mut c = [(0.0f32, 0u32); W];
                 let mut n = 0;
-                for l in 0..4 {
+                for l in 0..W {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
                         c[n] = (e[l], node.child[l]);
                         n += 1;
@@ -421,7 +423,7 @@ impl WideBvh {
         if self.root == EMPTY {
             return false;
         }
-        let rb = RayBox4::new(ray);
+        let rb = RayBox::new(ray);
         let tr = TriRay::new(ray);
         let mut stack = [0u32; STACK];
         stack[0] = self.root;
@@ -432,7 +434,7 @@ impl WideBvh {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
                 let e = rb.entry(node, t_max);
-                for l in 0..4 {
+                for l in 0..W {
                     if e[l] < f32::INFINITY && node.child[l] != EMPTY {
                         self.prefetch(node.child[l]);
                         stack[sp] = node.child[l];
@@ -461,7 +463,7 @@ struct Collapse<'a> {
 }
 
 impl Collapse<'_> {
-    /// True if binary node `i` becomes a 4-wide node (not a leaf).
+    /// True if binary node `i` becomes a wide node (not a leaf).
     fn opens(&self, i: usize) -> bool {
         self.bin[i].count == 0 && self.range[i].1 > LEAF_TRIANGLES
     }
@@ -479,8 +481,8 @@ impl Collapse<'_> {
         // Children in slot order: two, then grandchildren (see the module doc).
         let kids2 = |j: usize| [j + 1, self.bin[j].offset as usize];
         let [l, r] = kids2(i);
-        // Up to four children, in a fixed array (no allocation per node).
-        let mut kids = [0usize; 4];
+        // Up to W children, in a fixed array (no allocation per node).
+        let mut kids = [0usize; W];
         let mut m = 0;
         for c in [l, r] {
             if self.opens(c) {
@@ -491,19 +493,19 @@ impl Collapse<'_> {
                 m += 1;
             }
         }
-        if m == 3 {
+        // Then the largest child that opens is replaced by its two, until there are W.
+        while m < W {
             let area = |j: usize| self.bin[j].aabb().surface_area();
-            let pick = (0..3).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
-            if let Some(k) = pick {
-                let [a, b] = kids2(kids[k]);
-                kids.copy_within(k + 1..3, k + 2);
-                kids[k..k + 2].copy_from_slice(&[a, b]);
-                m = 4;
-            }
+            let pick = (0..m).filter(|&k| self.opens(kids[k])).max_by(|&a, &b| area(kids[a]).total_cmp(&area(kids[b])));
+            let Some(k) = pick else { break };
+            let [a, b] = kids2(kids[k]);
+            kids.copy_within(k + 1..m, k + 2);
+            kids[k..k + 2].copy_from_slice(&[a, b]);
+            m += 1;
         }
         let kids = &kids[..m];
         let me = self.out.nodes.len();
-        self.out.nodes.push(Node4::EMPTY);
+        self.out.nodes.push(WideNode::EMPTY);
         for (lane, &k) in kids.iter().enumerate() {
             let r = self.subtree(k);
             self.out.nodes[me].set(lane, self.bin[k].aabb(), r);
@@ -598,8 +600,14 @@ mod tests {
             assert!(n <= LEAF_TRIANGLES && nb == n.div_ceil(4) as usize, "leaf of {n} triangles in {nb} blocks");
             return n;
         }
-        let n = w.nodes[r as usize].child.iter().filter(|&&c| c != EMPTY).map(|&c| covered(w, c)).sum();
+        let kids = w.nodes[r as usize].child;
+        let n = kids.iter().filter(|&&c| c != EMPTY).map(|&c| covered(w, c)).sum();
         assert!(n > LEAF_TRIANGLES, "a node over {n} triangles should have been a leaf");
+        // The collapse fills a node to W children while any child can open, so a node
+        // with an unused slot has only leaves below it.
+        if kids.contains(&EMPTY) {
+            assert!(kids.iter().all(|&c| c == EMPTY || c & LEAF != 0), "node {r} has room but a node child");
+        }
         n
     }
 
@@ -619,7 +627,7 @@ mod tests {
     fn matches_brute_force_on_triangle_soup() {
         let tris = soup(3000, 1);
         let w = WideBvh::build(&verts(&tris));
-        assert!(w.sah_cost() > 1.0 && w.node_count() > 100);
+        assert!(w.sah_cost() > 1.0 && w.node_count() > 50);
         let mut order = w.prim_order().to_vec();
         order.sort();
         assert!(order.iter().enumerate().all(|(i, &k)| i as u32 == k), "prim_order is a permutation");
@@ -736,7 +744,7 @@ mod tests {
         for (tris, (probe, t)) in [deep, same].into_iter().zip(probes) {
             let w = WideBvh::build(&tris);
             let lv = levels(&w, w.root);
-            assert!(lv >= 4 && 3 * lv < STACK, "{lv} levels");
+            assert!(lv >= 3 && (W - 1) * lv < STACK, "{lv} levels");
             for r in &nan {
                 assert!(w.intersect(r, f32::INFINITY).is_none() && !w.occluded(r, f32::INFINITY));
             }
