@@ -22,6 +22,8 @@
 //! Traversal stack: every node below the root sits at least two binary levels under its
 //! parent node, so a binary tree of depth below [`BINARY_DEPTH`] gives at most
 //! `BINARY_DEPTH / 2` node levels, and `W - 1` pending siblings per level fit [`STACK`].
+//! A tree whose own deepest traversal fits [`SMALL_STACK`] (measured after the build) is
+//! traversed with that smaller stack, which is cheaper to zero for every ray.
 
 // Lane loops `for l in 0..W` index several arrays by lane on purpose: that is the form the
 // compiler vectorises.
@@ -55,6 +57,11 @@ const BINARY_DEPTH: u32 = 42;
 const LEAF_TRIANGLES: u32 = 12;
 /// Traversal stack entries: `W - 1` pending children per node level, plus one.
 const STACK: usize = (W - 1) * (BINARY_DEPTH as usize / 2) + 1;
+/// Traversal stack entries for a tree whose deepest traversal fits them (the full dragon's
+/// needs 54; [`WideBvh::stack_need`]): an array of [`STACK`] entries, zeroed for every
+/// ray as safe Rust requires, compiled to a call to `memset` of 84 instructions, a third
+/// of a primary ray's; 64 entries (512 bytes) are zeroed by 16 inline vector stores.
+const SMALL_STACK: usize = 64;
 /// Reference flag of a leaf; its bits 28-30 hold the block count minus one and bits
 /// 0-27 the first block.
 const LEAF: u32 = 1 << 31;
@@ -120,6 +127,8 @@ pub struct WideBvh {
     order: Vec<u32>,
     root: u32,
     bounds: Aabb,
+    /// True if every traversal fits [`SMALL_STACK`] entries.
+    shallow: bool,
 }
 
 /// Per-ray data of the wide slab test.
@@ -218,6 +227,7 @@ impl WideBvh {
             block_first: Vec::with_capacity(n / 2 + 1),
             order: Vec::new(),
             root: EMPTY,
+            shallow: true,
             bounds: bin.first().map_or(Aabb::EMPTY, |n| n.aabb()),
         };
         // The arrays are advised before they are written, so that their first touch
@@ -228,6 +238,7 @@ impl WideBvh {
         if !bin.is_empty() {
             let mut c = Collapse { bin: &bin, range: &range, out: &mut w };
             w.root = c.subtree(0);
+            w.shallow = w.stack_need(w.root) < SMALL_STACK;
         }
         drop((bin, range));
         // The blocks, filled in parallel in their final order (the collapse above only
@@ -269,6 +280,18 @@ impl WideBvh {
             let n = ((r >> 28) & 7) as usize + 1;
             prefetch_blocks(self.blocks.as_ptr().wrapping_add((r & BLOCK_MASK) as usize), n);
         }
+    }
+
+    /// Most entries a traversal from `r` can leave on its stack: a visit to a node pushes
+    /// at most all but one of its children, and those wait while one path below it is
+    /// followed, so this is the largest sum of `children - 1` over the nodes of a path
+    /// (the any-hit traversal pushes the last child too: one more).
+    fn stack_need(&self, r: u32) -> usize {
+        if r & LEAF != 0 {
+            return 0;
+        }
+        let kids = self.nodes[r as usize].child.into_iter().filter(|&c| c != EMPTY);
+        kids.clone().count() - 1 + kids.map(|c| self.stack_need(c)).max().unwrap_or(0)
     }
 
     /// Slot order: `prim_order()[slot]` is the triangle's index in the slice given to
@@ -334,6 +357,12 @@ impl WideBvh {
     /// between triangles at the same `t` go to the first one found.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
+        if self.shallow { self.closest::<SMALL_STACK>(ray, t_max) } else { self.closest::<STACK>(ray, t_max) }
+    }
+
+    /// [`WideBvh::intersect`] with a stack of `S` entries (at least [`WideBvh::stack_need`]).
+    #[inline(always)]
+    fn closest<const S: usize>(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
         if self.root == EMPTY {
             return None;
         }
@@ -341,7 +370,7 @@ impl WideBvh {
         let tr = TriRay::new(ray);
         let mut t_max = t_max;
         let mut best = None;
-        let mut stack = [(0u32, 0.0f32); STACK];
+        let mut stack = [(0u32, 0.0f32); S];
         let mut sp = 0usize;
         let mut cur = self.root;
         loop {
@@ -420,12 +449,18 @@ impl WideBvh {
     /// True if any triangle blocks the ray with `0 < t < t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.shallow { self.any_hit::<SMALL_STACK>(ray, t_max) } else { self.any_hit::<STACK>(ray, t_max) }
+    }
+
+    /// [`WideBvh::occluded`] with a stack of `S` entries (more than [`WideBvh::stack_need`]).
+    #[inline(always)]
+    fn any_hit<const S: usize>(&self, ray: &Ray, t_max: f32) -> bool {
         if self.root == EMPTY {
             return false;
         }
         let rb = RayBox::new(ray);
         let tr = TriRay::new(ray);
-        let mut stack = [0u32; STACK];
+        let mut stack = [0u32; S];
         stack[0] = self.root;
         let mut sp = 1usize;
         while sp > 0 {
@@ -732,23 +767,33 @@ mod tests {
             Ray { origin: Vec3::new(f32::NAN, 0.0, 0.0), dir: Vec3::Z },
             Ray { origin: Vec3::ZERO, dir: Vec3::new(0.0, f32::NAN, 1.0) },
         ];
-        let deep: Vec<[Vec3; 3]> = (0..3000)
-            .map(|i| {
-                let s = 1.02f32.powi(i);
-                [Vec3::new(s, 0.0, 0.0), Vec3::new(s, s, 0.0), Vec3::new(s, 0.0, s)]
-            })
-            .collect();
+        // A NaN ray's traversal visits the whole tree and fills its stack as far as the
+        // tree allows: these trees need 56 entries (the small stack) and 78 (the large).
+        let deep = |n: i32, g: f32| -> Vec<[Vec3; 3]> {
+            (0..n)
+                .map(|i| {
+                    let s = g.powi(i);
+                    [Vec3::new(s, 0.0, 0.0), Vec3::new(s, s, 0.0), Vec3::new(s, 0.0, s)]
+                })
+                .collect()
+        };
         let same = vec![[Vec3::ZERO, Vec3::X, Vec3::Y]; 1000];
-        let probes =
-            [(Ray::new(Vec3::new(-1.0, 0.1, 0.1), Vec3::X), 2.0), (Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z), 1.0)];
-        for (tris, (probe, t)) in [deep, same].into_iter().zip(probes) {
+        let probes = [
+            (Ray::new(Vec3::new(-1.0, 0.1, 0.1), Vec3::X), 2.0, true),
+            (Ray::new(Vec3::new(-1.0, 0.1, 0.1), Vec3::X), 2.0, false),
+            (Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z), 1.0, true),
+        ];
+        for (tris, (probe, t, shallow)) in [deep(1000, 1.02), deep(3000, 1.02), same].into_iter().zip(probes) {
             let w = WideBvh::build(&tris);
             let lv = levels(&w, w.root);
             assert!(lv >= 3 && (W - 1) * lv < STACK, "{lv} levels");
+            let need = w.stack_need(w.root);
+            assert!(w.shallow == shallow && need < STACK && (need > 40 || tris[0] == tris[1]), "needs {need}");
             for r in &nan {
                 assert!(w.intersect(r, f32::INFINITY).is_none() && !w.occluded(r, f32::INFINITY));
             }
             assert_eq!(w.intersect(&probe, f32::INFINITY).map(|h| h.t), Some(t));
+            assert!(w.occluded(&probe, f32::INFINITY));
         }
     }
 }
