@@ -1,8 +1,8 @@
 //! Hints to the memory system for the triangle BVH: the crate's only `unsafe` code.
 //!
-//! Incoherent rays through a large mesh (the full Stanford dragon: 48 MB of nodes and
+//! Incoherent rays through a large mesh (the full Stanford dragon: 50 MB of nodes and
 //! triangle blocks) spend most of their time waiting for memory: a node's box test needs
-//! its two cache lines, and the child to visit next is known only after that test. Two
+//! all its cache lines, and the child to visit next is known only after that test. Two
 //! hints overlap or shorten those waits, as Embree does (docs/performance.md, round 5):
 //!
 //! - [`prefetch_node`] / [`prefetch_blocks`]: when a node's children are known, their

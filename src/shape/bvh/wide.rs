@@ -39,11 +39,12 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// Children per node. Measured against 4 (128-byte nodes; the same leaves, so the same
-/// hits bit for bit) on the full dragon, in one process, alternating passes: incoherent
-/// rays +12% and +16%, primary rays +1% (docs/performance.md, round 8). On a CPU with
-/// AVX an 8-lane box test is as many instructions as a 4-lane one, and a ray visits fewer
-/// nodes (SAH cost 19.8 against 25.7). Round 2 measured 8-wide nodes as no faster on the
-/// SSE2 baseline with leaves of one block.
+/// hits bit for bit) on the full dragon's ray files: incoherent rays 1.12-1.16x in
+/// in-process pairs and 1.17x in a 15-round sitting, primary rays 1.01x in both
+/// (docs/performance.md, round 8). On a CPU with AVX an 8-lane box test is as many
+/// instructions as a 4-lane one, and a ray visits fewer nodes (SAH cost 19.8 against
+/// 25.7). Round 2 measured 8-wide nodes as no faster on the SSE2 baseline with leaves of
+/// one block.
 const W: usize = 8;
 /// Depth limit of the binary tree that is collapsed (see the module doc).
 const BINARY_DEPTH: u32 = 42;
