@@ -189,13 +189,12 @@ fn bins_of(c: Vec3A, lo: Vec3A, scale: Vec3A) -> [usize; 3] {
 /// Adds `prims` to `bins`.
 fn fill_bins(bins: &mut Bins, prims: &[BuildPrim], lo: Vec3A, scale: Vec3A) {
     for p in prims {
-        let b = p.bounds();
-        let i = bins_of((b.min + b.max) * 0.5, lo, scale);
+        let i = bins_of(p.centroid(), lo, scale);
         for a in 0..3 {
             // (`i[a] <= BINS - 1` already; the mask lets the compiler drop the bounds check.)
             let bin = &mut bins[a][i[a] & (BINS - 1)];
             bin.count += 1;
-            bin.bounds = bin.bounds.union(b);
+            bin.bounds = bin.bounds.union(p.bounds());
         }
     }
 }
@@ -420,14 +419,13 @@ impl Side {
 /// bounds of each side.
 fn partition(prims: &mut [BuildPrim], axis: usize, lo: f32, scale: f32, last: usize) -> (usize, Box3A, Box3A) {
     let side = Side::new(axis, lo, scale, last);
-    let left = |c: Vec3A| side.left(c);
     let (mut lcb, mut rcb) = (Box3A::EMPTY, Box3A::EMPTY);
     let mut i = 0;
     let mut j = prims.len();
     loop {
         while i < j {
             let c = prims[i].centroid();
-            if !left(c) {
+            if !side.left(c) {
                 break;
             }
             lcb = lcb.grow(c);
@@ -435,7 +433,7 @@ fn partition(prims: &mut [BuildPrim], axis: usize, lo: f32, scale: f32, last: us
         }
         while i < j {
             let c = prims[j - 1].centroid();
-            if left(c) {
+            if side.left(c) {
                 break;
             }
             rcb = rcb.grow(c);
