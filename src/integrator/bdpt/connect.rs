@@ -1,0 +1,301 @@
+//! The strategies `(s, t)`: joining a camera prefix and a light prefix, with the
+//! segment between them (visibility and transmittance).
+
+use glam::{Vec2, Vec3};
+
+use crate::bxdf::{Crossing, MediumStack};
+use crate::color::Spectrum;
+use crate::geometry::Ray;
+use crate::integrator::{MAX_PASSES, absorption};
+use crate::sampler::{Dim, Sampler};
+use crate::scene::Scene;
+use crate::spectral::Lambdas;
+
+use super::mis::{Overrides, mis_weight};
+use super::vertex::{
+    Contrib, Kind, Vertex, Wavelength, connectible, emit_factor, is_dispersive, material, outside, pdf_at, pdf_light,
+    shading_correction, to_area,
+};
+use super::{Bdpt, Sub};
+
+impl Bdpt {
+    /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye. Returns
+    /// the film position and the MIS-weighted contribution.
+    pub(super) fn connect_camera(
+        &self,
+        scene: &Scene,
+        light: Sub<'_>,
+        s: usize,
+        camera: Sub<'_>,
+        wl: &mut Wavelength,
+    ) -> Option<(Vec2, Contrib)> {
+        let qs = &light.v[s - 1];
+        if !connectible(scene, qs) {
+            return None;
+        }
+        let cam = &scene.camera;
+        let eye = cam.eye();
+        let to_eye = eye - qs.p();
+        let d2 = to_eye.length_squared();
+        if d2.is_nan() || d2 <= 0.0 {
+            return None;
+        }
+        let w = to_eye / d2.sqrt();
+        let film = cam.project(-w)?;
+        let cos_cam = (-w).dot(cam.forward());
+        let importance = 1.0 / (d2 * cam.plane_area() * cos_cam * cos_cam * cos_cam);
+        let single = qs.collapsed || is_dispersive(scene, qs);
+        // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
+        let c = match qs.kind {
+            Kind::Light(i) => {
+                let light = &scene.lights[i as usize];
+                if light.is_delta() {
+                    // Point and spot lights are invisible to the camera in every
+                    // integrator (path tracing cannot see them either).
+                    return None;
+                }
+                let e = emit_factor(light, qs.sh.n, w) * importance;
+                if e.is_nan() || e <= 0.0 {
+                    return None;
+                }
+                if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
+            }
+            Kind::Surface(o) => {
+                let bxdf = material(scene, o);
+                let wi = qs.sh.frame.to_local(w);
+                if !qs.sh.consistent(w, wi) {
+                    return None;
+                }
+                let k = wi.z.abs() * shading_correction(&qs.sh, w, wi) * importance;
+                let out = outside(scene, qs.outside);
+                if single {
+                    let one = wl.single();
+                    let f = bxdf.eval_within(wi, qs.sh.wo, &one.lambdas, out)[0];
+                    Contrib::Single(wl.at(&qs.beta, qs.collapsed) * f * k)
+                } else {
+                    Contrib::Full(qs.beta * bxdf.eval_within(wi, qs.sh.wo, &Lambdas::full(), out) * k)
+                }
+            }
+            Kind::Camera => return None,
+        };
+        if is_black(&c) {
+            return None;
+        }
+        let transmittance = segment(scene, qs, light.media_towards(scene, s - 1, w).as_ref(), eye)?;
+        let weight = if self.light_only {
+            1.0
+        } else {
+            let eye_v = &camera.v[0];
+            let qs_rev = to_area(scene, cam.pdf_dir(-w), eye_v, qs);
+            let qsm_rev = match qs.kind {
+                Kind::Surface(_) if s >= 2 => pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev,
+                _ => 0.0,
+            };
+            mis_weight(scene, camera.v, 1, light.v, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
+        };
+        Some((film, scale(c, weight, transmittance, wl)))
+    }
+
+    /// Strategies `(s, t ≥ 2)`: emitter hit (`s = 0`), next-event estimation
+    /// (`s = 1`), or a connection of `x_{t-1}` and `y_{s-1}`; MIS-weighted.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn connect(
+        &self,
+        scene: &Scene,
+        camera: Sub<'_>,
+        t: usize,
+        light: Sub<'_>,
+        s: usize,
+        sampler: &mut Sampler,
+        wl: &mut Wavelength,
+    ) -> Contrib {
+        const NONE: Contrib = Contrib::Full(Spectrum::ZERO);
+        let pt = &camera.v[t - 1];
+        let Kind::Surface(object) = pt.kind else {
+            return NONE;
+        };
+        let ptm = &camera.v[t - 2];
+        match s {
+            0 => {
+                // The camera subpath ends on an emitter.
+                let Some(index) = scene.objects[object as usize].light else {
+                    return NONE;
+                };
+                let light = &scene.lights[index as usize];
+                let dir = (pt.p() - ptm.p()).normalize();
+                let le = light.le_scale(pt.sh.n, dir);
+                if le <= 0.0 {
+                    return NONE;
+                }
+                let c = if pt.collapsed {
+                    let one = wl.single();
+                    Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(light.spectrum())[0] * le)
+                } else {
+                    Contrib::Full(pt.beta * *light.spectrum() * le)
+                };
+                let (pdf_pos, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
+                let pt_rev = scene.light_pmf[index as usize] * pdf_pos;
+                let as_light = Vertex { kind: Kind::Light(index), ..*pt };
+                let ptm_rev = to_area(scene, pdf_dir, &as_light, ptm);
+                let overrides = Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 };
+                scale(c, mis_weight(scene, camera.v, t, &[], 0, overrides), None, wl)
+            }
+            1 => {
+                // Next-event estimation: a fresh point on a light.
+                let (u_light, u) = (
+                    sampler.get_1d_if(scene.lights.len() > 1, Dim::light_choice(t as u32 - 2)),
+                    sampler.get_2d(Dim::light_sample(t as u32 - 2)),
+                );
+                if !connectible(scene, pt) {
+                    return NONE;
+                }
+                let Some((index, pmf)) = scene.choose_light(u_light) else {
+                    return NONE;
+                };
+                let light = &scene.lights[index];
+                let Some(ls) = light.sample_li(pt.p(), u) else {
+                    return NONE;
+                };
+                let wi = pt.sh.frame.to_local(ls.wi);
+                if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
+                    return NONE;
+                }
+                let bxdf = material(scene, object);
+                let out = outside(scene, pt.outside);
+                let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
+                let c = if pt.collapsed || is_dispersive(scene, pt) {
+                    let one = wl.single();
+                    let f = bxdf.eval_within(pt.sh.wo, wi, &one.lambdas, out)[0];
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(light.spectrum())[0] * k)
+                } else {
+                    Contrib::Full(
+                        pt.beta * bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out) * *light.spectrum() * k,
+                    )
+                };
+                if is_black(&c) {
+                    return NONE;
+                }
+                let media = camera.media_towards(scene, t - 1, ls.wi);
+                let Some(transmittance) = segment(scene, pt, media.as_ref(), ls.point) else {
+                    return NONE;
+                };
+                // The sampled light vertex, for the MIS weight.
+                let (pdf_pos, _) = light.pdf_le(ls.n, -ls.wi);
+                let y = Vertex::at_point(Kind::Light(index as u32), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
+                let pt_rev = pdf_light(scene, &y, pt);
+                let ptm_rev = bxdf.pdf_within(wi, pt.sh.wo, &Lambdas::full(), out) * pt.g_prev;
+                let qs_rev = to_area(scene, bxdf.pdf_within(pt.sh.wo, wi, &Lambdas::full(), out), pt, &y);
+                let overrides = Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 };
+                let weight = mis_weight(scene, camera.v, t, std::slice::from_ref(&y), 1, overrides);
+                scale(c, weight, transmittance, wl)
+            }
+            _ => {
+                let qs = &light.v[s - 1];
+                if !connectible(scene, pt) || !connectible(scene, qs) {
+                    return NONE;
+                }
+                let Kind::Surface(q_object) = qs.kind else {
+                    return NONE;
+                };
+                let d = qs.p() - pt.p();
+                let d2 = d.length_squared();
+                if d2.is_nan() || d2 <= 0.0 {
+                    return NONE;
+                }
+                let w = d / d2.sqrt();
+                let (wi_p, wi_q) = (pt.sh.frame.to_local(w), qs.sh.frame.to_local(-w));
+                if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
+                    return NONE;
+                }
+                let (bp, bq) = (material(scene, object), material(scene, q_object));
+                let (op, oq) = (outside(scene, pt.outside), outside(scene, qs.outside));
+                let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
+                let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {
+                    let one = wl.single();
+                    let fp = bp.eval_within(pt.sh.wo, wi_p, &one.lambdas, op)[0];
+                    let fq = bq.eval_within(wi_q, qs.sh.wo, &one.lambdas, oq)[0];
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
+                } else {
+                    let full = Lambdas::full();
+                    let (fp, fq) =
+                        (bp.eval_within(pt.sh.wo, wi_p, &full, op), bq.eval_within(wi_q, qs.sh.wo, &full, oq));
+                    Contrib::Full(pt.beta * fp * fq * qs.beta * k)
+                };
+                if is_black(&c) {
+                    return NONE;
+                }
+                let media = camera.media_towards(scene, t - 1, w);
+                let Some(transmittance) = segment(scene, pt, media.as_ref(), qs.p()) else {
+                    return NONE;
+                };
+                // The four densities the connection changes, from the local
+                // directions already at hand (`wo` points back along each subpath).
+                let full = Lambdas::full();
+                let pt_rev = bq.pdf_within(qs.sh.wo, wi_q, &full, oq) * w.dot(pt.sh.n).abs() / d2;
+                let qs_rev = bp.pdf_within(pt.sh.wo, wi_p, &full, op) * w.dot(qs.sh.n).abs() / d2;
+                let ptm_rev = bp.pdf_within(wi_p, pt.sh.wo, &full, op) * pt.g_prev;
+                let qsm_rev = bq.pdf_within(wi_q, qs.sh.wo, &full, oq) * qs.g_prev;
+                let weight = mis_weight(scene, camera.v, t, light.v, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
+                scale(c, weight, transmittance, wl)
+            }
+        }
+    }
+}
+
+/// True when a contribution is zero. (A NaN is not: it reaches the film,
+/// which drops and counts it, so a bug cannot hide here.)
+#[inline]
+pub(super) fn is_black(c: &Contrib) -> bool {
+    match c {
+        Contrib::Full(s) => s.is_black(),
+        Contrib::Single(v) => *v == 0.0,
+    }
+}
+
+/// A contribution times the MIS weight and a segment's transmittance (if
+/// the segment runs inside an absorbing dielectric).
+#[inline]
+pub(super) fn scale(c: Contrib, weight: f32, transmittance: Option<Spectrum>, wl: &mut Wavelength) -> Contrib {
+    match (c, transmittance) {
+        (Contrib::Full(s), None) => Contrib::Full(s * weight),
+        (Contrib::Full(s), Some(tr)) => Contrib::Full(s * tr * weight),
+        (Contrib::Single(v), None) => Contrib::Single(v * weight),
+        (Contrib::Single(v), Some(tr)) => Contrib::Single(v * wl.at(&tr, false) * weight),
+    }
+}
+
+/// The segment of a connection from vertex `v` to point `to`, starting in
+/// `media` (the media around `v` on the segment's side; `None` in a scene
+/// without dielectrics). `None` when something blocks it; else the
+/// segment's transmittance when it runs in an absorbing medium.
+///
+/// Among nested dielectrics a segment passes false intersections (surfaces
+/// the medium stack says are not interfaces here, at most [`MAX_PASSES`]);
+/// the medium it runs in does not change at them, so one Beer-Lambert factor
+/// of the current medium over the whole length is exact.
+pub(super) fn segment(scene: &Scene, v: &Vertex, media: Option<&MediumStack>, to: Vec3) -> Option<Option<Spectrum>> {
+    let (mut ray, mut t_max) = Ray::spawn_to(v.p(), v.sh.n, to);
+    match media {
+        Some(stack) if scene.has_nested_media() => {
+            let mut stack = *stack;
+            let mut passes = 0;
+            while let Some(si) = scene.intersect(&ray, t_max) {
+                let entering = ray.dir.dot(si.hit.n) < 0.0;
+                match scene.medium(si.object) {
+                    Some(m) if passes < MAX_PASSES && stack.crossing(m, entering) == Crossing::Pass => {
+                        stack.cross(m, entering);
+                        passes += 1;
+                        (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to);
+                    }
+                    _ => return None,
+                }
+            }
+        }
+        _ => {
+            if scene.occluded(&ray, t_max) {
+                return None;
+            }
+        }
+    }
+    Some(absorption(scene, media.and_then(|m| m.current())).map(|sigma| (*sigma * -(to - v.p()).length()).exp()))
+}

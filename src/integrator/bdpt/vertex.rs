@@ -1,0 +1,230 @@
+//! Subpath vertices, the sample's collapsed wavelength, and the densities and
+//! material queries a vertex answers.
+
+use std::sync::LazyLock;
+
+use glam::Vec3;
+
+use crate::bxdf::{Bxdf, Outside};
+use crate::color::{N_BINS, Spectrum};
+use crate::geometry::Frame;
+use crate::light::Light;
+use crate::scene::Scene;
+use crate::spectral::{BinDistribution, Lambdas, Readout, bin_importance, continuous_wavelength};
+
+use crate::integrator::Shading;
+
+/// What a subpath vertex is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// The eye.
+    Camera,
+    /// A point on light `index`.
+    Light(u32),
+    /// A surface point of object `index`.
+    Surface(u32),
+}
+
+/// A subpath vertex.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Vertex {
+    pub(super) kind: Kind,
+    /// Position, geometric normal, shading frame and the local direction
+    /// back along the subpath (`wo`).
+    pub(super) sh: Shading,
+    /// Throughput of the subpath up to and including this vertex's arrival.
+    pub(super) beta: Spectrum,
+    /// The scattering sampled here was a delta lobe.
+    pub(super) delta: bool,
+    /// The subpath collapsed to one wavelength before reaching this vertex.
+    pub(super) collapsed: bool,
+    /// Area density of this vertex as its own walk generated it.
+    pub(super) pdf_fwd: f32,
+    /// Area density of this vertex as a walk from the other end would.
+    pub(super) pdf_rev: f32,
+    /// The factor that turns a density per solid angle here towards the
+    /// previous vertex into an area density there: `|cos| / d²` at the
+    /// previous vertex (no cosine at the eye or a point light; 0 at a
+    /// subpath's first vertex). Kept so connections need not recompute it.
+    pub(super) g_prev: f32,
+    /// At a dielectric's surface, the material of the medium on its outside
+    /// (`None`: vacuum, or not a dielectric).
+    pub(super) outside: Option<u32>,
+}
+
+impl Vertex {
+    pub(super) fn at_point(kind: Kind, p: Vec3, n: Vec3, beta: Spectrum, pdf_fwd: f32) -> Vertex {
+        let frame = Frame::from_z(if n == Vec3::ZERO { Vec3::Z } else { n });
+        let sh = Shading { p, n, frame, wo: Vec3::Z, wo_n: 0.0 };
+        Vertex { kind, sh, beta, delta: false, collapsed: false, pdf_fwd, pdf_rev: 0.0, g_prev: 0.0, outside: None }
+    }
+
+    #[inline]
+    pub(super) fn p(&self) -> Vec3 {
+        self.sh.p
+    }
+
+    /// True when densities arriving at this vertex carry its cosine (area
+    /// measure on a surface): surfaces and area lights, not the eye or a
+    /// point, spot, distant or beam light.
+    #[inline]
+    pub(super) fn on_surface(&self, scene: &Scene) -> bool {
+        match self.kind {
+            Kind::Surface(_) => true,
+            Kind::Light(i) => !scene.lights[i as usize].is_delta(),
+            Kind::Camera => false,
+        }
+    }
+}
+
+/// The one wavelength a sample collapses to, drawn lazily from `u_λ`.
+pub(super) struct Wavelength {
+    pub(super) u: f32,
+    /// Continuous wavelengths (colour output); bin centres for spectral output.
+    pub(super) continuous: bool,
+    pub(super) drawn: Option<Single>,
+}
+
+/// The collapsed wavelength: the slot of a throughput that holds its value,
+/// and the packet of one wavelength (with the weight `1/p`) that evaluates
+/// materials at it and reads its value out as colour.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Single {
+    pub(super) slot: usize,
+    pub(super) lambdas: Lambdas<1>,
+}
+
+impl Wavelength {
+    /// The sample's wavelength (drawn on first use).
+    pub(super) fn single(&mut self) -> Single {
+        static DIST: LazyLock<BinDistribution> = LazyLock::new(|| {
+            let importance = bin_importance();
+            BinDistribution::new(|b| importance[b]).expect("visual importance is positive")
+        });
+        let (u, continuous) = (self.u, self.continuous);
+        *self.drawn.get_or_insert_with(|| {
+            if continuous {
+                let (lambdas, _) = continuous_wavelength(&DIST, u);
+                Single { slot: (lambdas.pos[0].round().max(0.0) as usize).min(N_BINS - 1), lambdas }
+            } else {
+                let (b, p) = DIST.sample(u);
+                Single { slot: b, lambdas: Lambdas { pos: [b as f32], weight: 1.0 / p, readout: Readout::Spectral } }
+            }
+        })
+    }
+
+    /// The value of throughput `v` at the sample's wavelength: the slot that
+    /// holds it once its subpath has collapsed, else its interpolation there.
+    pub(super) fn at(&mut self, v: &Spectrum, collapsed: bool) -> f32 {
+        let one = self.single();
+        if collapsed { v[one.slot] } else { one.lambdas.sample(v)[0] }
+    }
+}
+
+/// A strategy's contribution: the full spectrum, or one value at the
+/// sample's collapsed wavelength.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Contrib {
+    Full(Spectrum),
+    Single(f32),
+}
+
+/// Veach's correction of the adjoint BSDF for shading normals: the factor
+/// by which importance transport differs from radiance transport where the
+/// shading normal is not the geometric one (1 on flat geometry).
+#[inline]
+pub(super) fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 {
+    let den = sh.wo_n.abs() * wi_local.z.abs();
+    let c = sh.wo.z.abs() * wi.dot(sh.n).abs() / den;
+    if c.is_finite() { c } else { 0.0 }
+}
+
+/// The material of object `o`.
+#[inline]
+pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
+    &scene.materials[scene.objects[o as usize].material as usize]
+}
+
+/// True when a connection can end at `v`: a surface whose material has a
+/// non-delta part (a plastic whose walk sampled its mirror coat still has
+/// its diffuse base), or a light. Not the sampled lobe's `delta` flag,
+/// which only says how the walk continued.
+#[inline]
+pub(super) fn connectible(scene: &Scene, v: &Vertex) -> bool {
+    match v.kind {
+        Kind::Surface(o) => !material(scene, o).is_delta(),
+        Kind::Light(_) | Kind::Camera => true,
+    }
+}
+
+/// True when vertex `v` lies on a dispersive surface (its glass or the
+/// medium outside it disperses).
+#[inline]
+pub(super) fn is_dispersive(scene: &Scene, v: &Vertex) -> bool {
+    matches!(v.kind, Kind::Surface(o) if material(scene, o).dispersion_within(outside(scene, v.outside)).is_some())
+}
+
+/// The emitted quantity from light point (normal `n`) towards `w`, as a
+/// factor of the light's spectrum, times the cosine at an area light.
+#[inline]
+pub(super) fn emit_factor(light: &Light, n: Vec3, w: Vec3) -> f32 {
+    match light {
+        Light::Point(_) => 1.0,
+        Light::Spot(l) => l.falloff(w),
+        Light::Distant(_) | Light::Beam(_) => 0.0,
+        Light::Sphere(_) | Light::Disk(_) | Light::Area(_) => light.le_scale(n, -w) * w.dot(n).abs(),
+    }
+}
+
+/// The medium outside a dielectric vertex, from its material index.
+#[inline]
+pub(super) fn outside(scene: &Scene, material: Option<u32>) -> Outside<'_> {
+    match material.and_then(|m| scene.materials[m as usize].as_dielectric()) {
+        Some(d) => Outside::medium(d),
+        None => Outside::VACUUM,
+    }
+}
+
+/// Converts a density per solid angle at `from` towards `to` into a density
+/// per unit area at `to`.
+#[inline]
+pub(super) fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -> f32 {
+    let d = to.p() - from.p();
+    let d2 = d.length_squared();
+    if d2.is_nan() || d2 <= 0.0 {
+        return 0.0;
+    }
+    let mut pdf = pdf_dir / d2;
+    if to.on_surface(scene) {
+        pdf *= (d.dot(to.sh.n) / d2.sqrt()).abs();
+    }
+    pdf
+}
+
+/// The BSDF density at surface vertex `v` for local directions `wo`, `wi`
+/// (0 for delta lobes).
+#[inline]
+pub(super) fn pdf_at(scene: &Scene, v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
+    match v.kind {
+        Kind::Surface(o) => material(scene, o).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside)),
+        _ => 0.0,
+    }
+}
+
+/// The area density at `next` of the ray `sample_le` would start from light
+/// vertex `y` towards it.
+#[inline]
+pub(super) fn pdf_light(scene: &Scene, y: &Vertex, next: &Vertex) -> f32 {
+    let Kind::Light(i) = y.kind else {
+        return 0.0;
+    };
+    let light = &scene.lights[i as usize];
+    let w = (next.p() - y.p()).normalize_or_zero();
+    let (pdf_pos, pdf_dir) = light.pdf_le(y.sh.n, w);
+    if light.is_delta_direction() {
+        // Parallel rays: the disk's density projected onto `next`.
+        let cos = if next.on_surface(scene) { w.dot(next.sh.n).abs() } else { 1.0 };
+        return pdf_pos * cos;
+    }
+    to_area(scene, pdf_dir, y, next)
+}

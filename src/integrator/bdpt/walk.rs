@@ -1,0 +1,179 @@
+//! Extending a subpath by BSDF sampling (radiance transport on the camera
+//! side, importance transport on the light side).
+
+use crate::bxdf::{Crossing, MediumStack};
+use crate::color::Spectrum;
+use crate::geometry::Ray;
+use crate::integrator::{MAX_PASSES, Shading, absorption};
+use crate::sampler::{Dim, Sampler};
+use crate::scene::Scene;
+use crate::spectral::Lambdas;
+
+use super::RR_DEPTH;
+use super::vertex::{Kind, Vertex, Wavelength, material, outside, shading_correction, to_area};
+
+/// A subpath walk's fixed parameters.
+pub(super) struct Walk {
+    /// Importance transport (the light subpath) rather than radiance.
+    pub(super) importance: bool,
+    /// The most vertices the subpath may have, its first included.
+    pub(super) max_vertices: usize,
+}
+
+impl Walk {
+    /// Extends `path` along `ray` by BSDF sampling. `pdf_dir` is the density
+    /// of `ray`'s direction at the last vertex (per solid angle; for a
+    /// `parallel` light, per area of its disk).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn run(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        mut beta: Spectrum,
+        mut pdf_dir: f32,
+        mut parallel: bool,
+        sampler: &mut Sampler,
+        path: &mut Vec<Vertex>,
+        mut stacks: Option<&mut Vec<MediumStack>>,
+        mut media: MediumStack,
+        wl: &mut Wavelength,
+    ) {
+        let full = Lambdas::full();
+        let beta_ref = beta.max_value();
+        let mut passes = 0;
+        let mut collapsed = false;
+        let mut bounces = 0u32;
+        // Radiance transport divides by η² at each refraction; roulette looks
+        // through that scaling (as the path tracer's does).
+        let mut eta_scale = 1.0f32;
+        while path.len() < self.max_vertices {
+            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let hit = si.hit;
+            let bxdf = material(scene, si.object);
+            // Beer-Lambert along the segment, in the medium it ran in.
+            if let Some(sigma) = absorption(scene, media.current()) {
+                if collapsed {
+                    let one = wl.single();
+                    beta[one.slot] *= (-one.lambdas.sample(sigma)[0] * hit.t).exp();
+                } else {
+                    beta *= (*sigma * -hit.t).exp();
+                }
+            }
+            // Nested dielectrics: a false intersection is no vertex; the walk
+            // goes straight on (densities stay those of the whole straight line).
+            let arrival = media;
+            let mut crossing = None;
+            let mut outside_material = None;
+            if let Some(m) = scene.medium(si.object) {
+                let entering = ray.dir.dot(hit.n) < 0.0;
+                match media.crossing(m, entering) {
+                    Crossing::Pass => {
+                        media.cross(m, entering);
+                        passes += 1;
+                        if passes > MAX_PASSES {
+                            break;
+                        }
+                        ray = Ray::spawn(hit.p, hit.n, ray.dir);
+                        continue;
+                    }
+                    Crossing::Interface { outside } => {
+                        crossing = Some((m, entering));
+                        outside_material = outside;
+                    }
+                }
+            }
+            passes = 0;
+            let out = outside(scene, outside_material);
+            let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
+            let prev = path.last().expect("a subpath starts at the eye or a light");
+            let mut v = Vertex {
+                kind: Kind::Surface(si.object),
+                sh,
+                beta,
+                delta: false,
+                collapsed,
+                pdf_fwd: 0.0,
+                pdf_rev: 0.0,
+                g_prev: 0.0,
+                outside: outside_material,
+            };
+            v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, prev, &v) };
+            v.g_prev = to_area(scene, 1.0, &v, prev);
+            parallel = false;
+            path.push(v);
+            if let Some(stacks) = stacks.as_deref_mut() {
+                stacks.push(arrival);
+            }
+            if path.len() >= self.max_vertices || bxdf.is_black() {
+                break;
+            }
+            let (reads_u, reads_uc) = bxdf.reads_draws();
+            let (u, uc) = (
+                sampler.get_2d_if(reads_u, Dim::bsdf(bounces).on_light_path_if(self.importance)),
+                sampler.get_1d_if(reads_uc, Dim::lobe(bounces).on_light_path_if(self.importance)),
+            );
+            let sample = if collapsed || bxdf.dispersion_within(out).is_some() {
+                let one = wl.single();
+                if !collapsed {
+                    // The direction depends on the wavelength: the subpath collapses to the
+                    // sample's wavelength; its throughput's value there moves to the slot.
+                    let v = one.lambdas.sample(&beta)[0];
+                    beta = Spectrum::ZERO;
+                    beta[one.slot] = v;
+                    collapsed = true;
+                }
+                bxdf.sample_within(sh.wo, u, uc, &one.lambdas, out).map(|s| {
+                    let mut f = Spectrum::ZERO;
+                    f[one.slot] = s.f[0];
+                    crate::bxdf::BsdfSample { wi: s.wi, f, pdf: s.pdf, is_delta: s.is_delta, eta: s.eta }
+                })
+            } else {
+                bxdf.sample_within(sh.wo, u, uc, &full, out)
+            };
+            let Some(bs) = sample else {
+                break;
+            };
+            let wi = sh.frame.to_world(bs.wi);
+            if !sh.consistent(wi, bs.wi) || bs.pdf.is_nan() || bs.pdf <= 0.0 {
+                break;
+            }
+            let mut weight = bs.f * (bs.wi.z.abs() / bs.pdf);
+            if self.importance {
+                // The adjoint BSDF: no 1/η² radiance scaling; Veach's shading-normal correction.
+                weight *= bs.eta * bs.eta * shading_correction(&sh, wi, bs.wi);
+            } else {
+                eta_scale *= bs.eta * bs.eta;
+            }
+            beta *= weight;
+            if let Some((m, entering)) = crossing
+                && wi.dot(hit.n) * ray.dir.dot(hit.n) > 0.0
+            {
+                media.cross(m, entering);
+            }
+            let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf_within(bs.wi, sh.wo, &full, out)) };
+            let n = path.len();
+            path[n - 1].delta = bs.is_delta;
+            path[n - 2].pdf_rev = rev * path[n - 1].g_prev;
+            pdf_dir = fwd;
+            if beta.is_black() {
+                break;
+            }
+            bounces += 1;
+            if bounces >= RR_DEPTH {
+                // Continue with probability min(1, relative throughput): a
+                // subpath that has lost nothing (a delta chain through clear
+                // glass) is never cut, so exact cases stay exact.
+                let q = (beta.max_value() * eta_scale / beta_ref).min(1.0);
+                if sampler.get_1d_if(q < 1.0, Dim::roulette(bounces - 1).on_light_path_if(self.importance)) >= q
+                    || q.is_nan()
+                {
+                    break;
+                }
+                beta /= q;
+            }
+            ray = Ray::spawn(hit.p, hit.n, wi);
+        }
+    }
+}
