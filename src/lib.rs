@@ -20,8 +20,9 @@
 //!   integral over 360-830 nm, `Σ_b L(b) · W_b` ([`color::color_weights`]), normalised so the
 //!   equal-energy spectrum of radiance 1 has `Y = 1`.
 //! - **Depth**: `max_bounces` counts scattering events ([`integrator`]).
-//! - **The outside medium** is vacuum, index 1, except inside dielectric
-//!   objects, which paths track on a medium stack ([`bxdf::medium`]).
+//! - **The outside** is vacuum, index 1, except inside dielectric objects,
+//!   whose volumes paths track on a stack ([`medium::nested`]); a volume may
+//!   hold an absorbing [`medium::Medium`].
 // One module may use `unsafe`: `shape::bvh::hint` (a prefetch and `madvise`, for speed;
 // see its doc). Everything else is safe Rust.
 #![deny(unsafe_code)]
@@ -37,6 +38,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod io;
 pub mod light;
+pub mod medium;
 pub mod render;
 pub(crate) mod sampler;
 pub mod scene;

@@ -22,8 +22,8 @@
 //!
 //! A dielectric's outside is vacuum unless a path is inside an enclosing
 //! dielectric: the `_within` forms of the verbs ([`Bxdf::sample_within`],
-//! ...) take that [`Outside`] medium, and [`medium`] holds the stack of media
-//! a path keeps (nested dielectrics). The plain verbs assume vacuum.
+//! ...) take that [`Outside`] medium, and [`crate::medium::nested`] holds the stack of
+//! dielectric volumes a path keeps (nested dielectrics). The plain verbs assume vacuum.
 //!
 //! Diffuse models, conductors and plastic are two-sided: they reflect into
 //! whichever hemisphere `wo` is in; a thin sheet is symmetric. The dielectric is oriented: `+z` is outside (the side the geometric
@@ -34,7 +34,6 @@ mod dielectric;
 mod fresnel;
 mod ior;
 mod lambertian;
-pub mod medium;
 mod metals;
 pub mod microfacet;
 mod oren_nayar;
@@ -52,7 +51,6 @@ pub use dielectric::{Dielectric, Outside};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, refract};
 pub use ior::{Ior, NAMED_GLASSES, named_glass};
 pub use lambertian::Lambertian;
-pub use medium::{Crossing, MEDIUM_STACK_DEPTH, Medium, MediumStack};
 pub use metals::{NAMED_METALS, named_metal};
 pub use oren_nayar::OrenNayar;
 pub use plastic::Plastic;
@@ -237,7 +235,7 @@ impl Bxdf {
 
     /// The absorption coefficient (per unit length) inside the model, for
     /// an absorbing dielectric: the integrators attenuate every segment that
-    /// runs in it (the current medium, [`medium`]) by `exp(−σ t)`.
+    /// runs in it (as the interior [`crate::medium::Medium`] of its volume) by `exp(−σ t)`.
     #[inline]
     pub fn absorption(&self) -> Option<&Spectrum> {
         match self {

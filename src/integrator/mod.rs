@@ -20,13 +20,21 @@
 //! `max_depth = k + 1`. The NEE shadow ray from the `k`-th bounce is allowed.
 //!
 //! # Nested dielectrics
-//! Every path carries a [`MediumStack`] (starting as [`Scene::camera_media`]):
+//! Every path carries a [`VolumeStack`] (starting as [`Scene::camera_volumes`]):
 //! at a dielectric's surface, `interface` decides whether the hit is a
 //! false intersection (passed straight through, no bounce counted, no light
 //! sample) or a real interface and what lies outside it; a transmission
-//! updates the stack (`Interface::scattered`). Segments, and shadow rays,
-//! are absorbed by the medium they run in (`Surround`). A path may pass at
-//! most `MAX_PASSES` (64) false intersections in a row (then it ends).
+//! updates the stack (`Interface::scattered`). Segments are attenuated by the
+//! medium they run in ([`Scene::medium_in`]); shadow rays and BDPT's
+//! connections follow one rule, [`Scene::transmittance`], which passes false
+//! intersections where volumes nest. A path may pass at most `MAX_PASSES`
+//! (64) false intersections in a row (then it ends).
+//!
+//! # The scene
+//! Integrators see the scene only through its queries (`crate::scene`'s
+//! `query` module: intersect, `bsdf`, `le`, `pdf_li`, `sample_li`, `light`,
+//! `volume`, `medium_in`, `transmittance`) and call the lights' and lobes'
+//! verbs; none matches a light or material variant.
 
 mod bdpt;
 mod path;
@@ -38,13 +46,16 @@ pub use whitted::Whitted;
 
 use glam::{Vec2, Vec3};
 
-use crate::bxdf::{Bxdf, Crossing, Medium, MediumStack, Outside};
-use crate::color::{Sampled, Spectrum};
+use crate::bxdf::{Bxdf, Outside};
+use crate::color::Sampled;
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
+use crate::medium::{Crossing, Volume, VolumeStack};
 use crate::sampler::warp::power_heuristic;
 use crate::sampler::{Dim, Sampler};
 use crate::scene::{Scene, SurfaceHit};
+
+pub(crate) use crate::scene::MAX_PASSES;
 use crate::settings::{IntegratorKind, WavelengthsKind};
 use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet, sample_packet_continuous};
 
@@ -168,8 +179,7 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
 /// surface (smooth glass, mirror, smooth metal, thin sheet), whose caustics
 /// no camera path can connect to the light. `auto` then picks `bdpt`.
 pub fn needs_bdpt(scene: &Scene) -> bool {
-    let delta_light = scene.lights.iter().any(|l| l.is_delta());
-    delta_light && scene.objects.iter().any(|o| scene.materials[o.material as usize].is_delta())
+    scene.has_delta_light() && scene.has_delta_surface()
 }
 
 /// One line saying which light-transport model the settings pick for this
@@ -247,10 +257,6 @@ impl Shading {
     }
 }
 
-/// The most false intersections a path passes in a row before it ends (a
-/// guard against degenerate geometry; real scenes need a handful).
-pub(crate) const MAX_PASSES: u32 = 64;
-
 /// A path's view of a surface hit among nested dielectrics.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Interface<'a> {
@@ -258,7 +264,7 @@ pub(crate) enum Interface<'a> {
     Pass,
     /// Scatter here, with `outside` on a dielectric's outside; `crossing`
     /// is the medium whose surface this is and whether the path enters it.
-    Scatter { outside: Outside<'a>, crossing: Option<(Medium, bool)> },
+    Scatter { outside: Outside<'a>, crossing: Option<(Volume, bool)> },
 }
 
 impl<'a> Interface<'a> {
@@ -275,7 +281,7 @@ impl<'a> Interface<'a> {
     /// normal `n` reached along `dir`: a transmission through a medium's
     /// surface enters or leaves it.
     #[inline]
-    pub fn scattered(&self, media: &mut MediumStack, dir: Vec3, n: Vec3, wi: Vec3) {
+    pub fn scattered(&self, media: &mut VolumeStack, dir: Vec3, n: Vec3, wi: Vec3) {
         if let Interface::Scatter { crossing: Some((m, entering)), .. } = *self
             && wi.dot(n) * dir.dot(n) > 0.0
         {
@@ -283,22 +289,18 @@ impl<'a> Interface<'a> {
         }
     }
 
-    /// The absorption on both sides of the surface, for shadow rays: the
-    /// medium the path is in (`media`, before crossing) and the one a
-    /// transmission would reach.
+    /// The volumes on one side of the surface, for a shadow ray: those the
+    /// path is in (`volumes`, before crossing) on `wo`'s side (`same_side`),
+    /// else those a transmission would reach.
     #[inline]
-    pub fn surround(&self, scene: &'a Scene, media: &MediumStack) -> Surround<'a> {
-        let front = absorption(scene, media.current());
-        let back = match self {
-            Interface::Scatter { crossing: Some((m, true)), .. } => absorption(scene, Some(*m)),
-            Interface::Scatter { crossing: Some((m, false)), .. } => {
-                let mut after = *media;
-                after.leave(m.object);
-                absorption(scene, after.current())
-            }
-            _ => front,
-        };
-        Surround { outside: self.outside(), front, back }
+    pub fn volumes_towards(&self, volumes: &VolumeStack, same_side: bool) -> VolumeStack {
+        let mut side = *volumes;
+        if let Interface::Scatter { crossing: Some((v, entering)), .. } = *self
+            && !same_side
+        {
+            side.cross(v, entering);
+        }
+        side
     }
 }
 
@@ -306,8 +308,8 @@ impl<'a> Interface<'a> {
 /// `media`: a false intersection (then `media` is updated) or a surface to
 /// scatter at.
 #[inline]
-pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut MediumStack, si: &SurfaceHit, dir: Vec3) -> Interface<'a> {
-    let Some(m) = scene.medium(si.object) else {
+pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut VolumeStack, si: &SurfaceHit, dir: Vec3) -> Interface<'a> {
+    let Some(m) = scene.volume(si.object) else {
         return Interface::Scatter { outside: Outside::VACUUM, crossing: None };
     };
     let entering = dir.dot(si.hit.n) < 0.0;
@@ -317,83 +319,59 @@ pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut MediumStack, si: &Surf
             Interface::Pass
         }
         Crossing::Interface { outside } => {
-            let outside = match outside.and_then(|o| scene.materials[o as usize].as_dielectric()) {
-                Some(d) => Outside::medium(d),
-                None => Outside::VACUUM,
-            };
-            Interface::Scatter { outside, crossing: Some((m, entering)) }
+            Interface::Scatter { outside: scene.outside(outside), crossing: Some((m, entering)) }
         }
     }
 }
 
-/// The absorption coefficient of `medium` (`None`: vacuum or clear).
-#[inline]
-pub(crate) fn absorption(scene: &Scene, medium: Option<Medium>) -> Option<&Spectrum> {
-    scene.materials[medium?.material as usize].absorption()
-}
-
-/// Around a vertex, for its light sample: the medium outside the
-/// dielectric whose surface it is (vacuum for other surfaces), and the
-/// absorption a shadow ray meets on `wo`'s side and across the surface.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Surround<'a> {
-    /// The medium on a dielectric's outside.
-    pub outside: Outside<'a>,
-    /// Absorption on `wo`'s side.
-    pub front: Option<&'a Spectrum>,
-    /// Absorption across the surface (a transmitted shadow ray).
-    pub back: Option<&'a Spectrum>,
-}
-
 /// One next-event estimate at a non-delta surface: a light chosen by power, a
-/// point on it sampled by solid angle or area, a shadow ray (absorbed by the
-/// medium it runs in, `surround`), and the MIS weight against BSDF sampling
-/// (power heuristic) when `mis` is set. Its numbers are the draws of depth `depth`.
+/// point on it sampled by solid angle or area, a shadow ray through
+/// [`Scene::transmittance`] (from the volumes the path is in, `volumes`, on the
+/// side the light is), and the MIS weight against BSDF sampling (power
+/// heuristic) when `mis` is set. Its numbers are the draws of depth `depth`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn sample_direct<const N: usize>(
     scene: &Scene,
     bxdf: &Bxdf,
     sh: &Shading,
-    surround: Surround<'_>,
+    at: &Interface<'_>,
+    volumes: &VolumeStack,
     lambdas: &Lambdas<N>,
     sampler: &mut Sampler,
     mis: bool,
     depth: u32,
 ) -> Sampled<N> {
     let zero = Sampled::splat(0.0);
-    let u_light = sampler.get_1d_if(scene.lights.len() > 1, Dim::light_choice(depth));
+    let u_light = sampler.get_1d_if(scene.light_count() > 1, Dim::light_choice(depth));
     let u = sampler.get_2d(Dim::light_sample(depth));
-    let Some((index, pmf)) = scene.choose_light(u_light) else {
+    let Some(choice) = scene.sample_li(sh.p, u_light, u) else {
         return zero;
     };
-    let light = &scene.lights[index];
-    let Some(ls) = light.sample_li(sh.p, u) else {
-        return zero;
-    };
+    let ls = choice.sample;
     let wi_local = sh.frame.to_local(ls.wi);
     if !sh.consistent(ls.wi, wi_local) {
         return zero;
     }
-    let mut f = bxdf.eval_within(sh.wo, wi_local, lambdas, surround.outside);
+    let outside = at.outside();
+    let mut f = bxdf.eval_within(sh.wo, wi_local, lambdas, outside);
     if f.is_black() {
         return zero;
     }
-    let (shadow, t_max) = Ray::spawn_to(sh.p, sh.n, ls.point);
-    if scene.occluded(&shadow, t_max) {
+    let side = scene.has_volumes().then(|| at.volumes_towards(volumes, ls.wi.dot(sh.n) * sh.wo_n > 0.0));
+    let Some(transmittance) = scene.transmittance(sh.p, sh.n, side.as_ref(), ls.point, lambdas) else {
         return zero;
+    };
+    if let Some(tr) = transmittance {
+        f *= tr;
     }
-    let medium = if ls.wi.dot(sh.n) * sh.wo_n > 0.0 { surround.front } else { surround.back };
-    if let Some(sigma) = medium {
-        f *= (lambdas.sample(sigma) * -(ls.point - sh.p).length()).exp();
-    }
-    let pdf_light = pmf * ls.pdf;
+    let pdf_light = choice.pmf * ls.pdf;
     let weight = if ls.is_delta || !mis {
         1.0
     } else {
-        power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, surround.outside))
+        power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, outside))
     };
-    f * lambdas.sample(light.spectrum()) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+    f * lambdas.sample(scene.light(choice.light).spectrum()) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
 }
 
 #[cfg(test)]
@@ -417,20 +395,20 @@ mod tests {
         let lambdas = Lambdas::full();
         let sin_between = |a: Vec3, n: Vec3| a.normalize().cross(n).length();
         // A ray inside the glass, hitting the water at incidence sine `sin_g`.
-        let refract = |media: &mut MediumStack, ray: Ray| {
+        let refract = |media: &mut VolumeStack, ray: Ray| {
             let si = scene.intersect(&ray, f32::INFINITY).unwrap();
             let at = interface(&scene, media, &si, ray.dir);
             assert!(matches!(at, Interface::Scatter { .. }));
             let sh = Shading::new(si.hit.p, si.hit.n, si.hit.ns, ray.dir);
-            let bxdf = &scene.materials[scene.objects[si.object as usize].material as usize];
+            let bxdf = scene.bsdf(si.object);
             let bs = bxdf.sample_within(sh.wo, Vec2::ZERO, 1.0 - 1e-7, &lambdas, at.outside()).unwrap();
             let wi = sh.frame.to_world(bs.wi);
             at.scattered(media, ray.dir, si.hit.n, wi);
             (si, wi)
         };
-        let glass = scene.medium(0).unwrap();
-        let water = scene.medium(1).unwrap();
-        let mut media = MediumStack::VACUUM;
+        let glass = scene.volume(0).unwrap();
+        let water = scene.volume(1).unwrap();
+        let mut media = VolumeStack::VACUUM;
         media.enter(glass);
         let (si, wi) = refract(&mut media, Ray::new(Vec3::new(-0.8, 0.3, 0.0), Vec3::X));
         let (sin_g, sin_w) = (sin_between(Vec3::X, si.hit.n), sin_between(wi, si.hit.n));
@@ -450,7 +428,7 @@ mod tests {
         assert!(wi.dot(si.hit.n) > 0.0, "reflected back into the glass");
         assert_eq!(media.current(), Some(glass), "reflected: still in the glass");
         // With vacuum outside, the same hit would have refracted.
-        let mut vacuum = MediumStack::VACUUM;
+        let mut vacuum = VolumeStack::VACUUM;
         let (si, wi) = refract(&mut vacuum, ray);
         assert!(wi.dot(si.hit.n) < 0.0 && vacuum.current() == Some(water));
     }

@@ -4,7 +4,7 @@
 //!
 //! One walk serves the `path`, `spectral` and `auto` integrators:
 //! 0. intersect; a segment inside an absorbing medium (the current medium
-//!    of the path's medium stack, [`crate::bxdf::medium`]) is attenuated by
+//!    of the path's medium stack, [`crate::medium::nested`]) is attenuated by
 //!    `exp(−σ t)` (Beer-Lambert);
 //! 1. at an emitter add `β · L_e`, MIS-weighted against light
 //!    sampling unless the previous bounce was delta (or this is the camera ray);
@@ -37,9 +37,10 @@
 //!    rule: a path that has lost nothing, a chain through clear glass, is
 //!    never cut).
 
-use crate::bxdf::{BsdfSample, Dispersion, MediumStack};
+use crate::bxdf::{BsdfSample, Dispersion};
 use crate::color::{N_BINS, Sampled, Spectrum};
 use crate::geometry::Ray;
+use crate::medium::VolumeStack;
 use crate::sampler::warp::power_heuristic;
 use crate::sampler::{Dim, Sampler};
 use crate::scene::{Scene, SurfaceHit};
@@ -47,7 +48,7 @@ use crate::spectral::{
     BinDistribution, Contribution, Lambdas, Readout, bin_importance, for_each_rotated, for_each_rotated_continuous,
 };
 
-use super::{Interface, MAX_PASSES, Shading, absorption, interface, sample_direct};
+use super::{Interface, MAX_PASSES, Shading, interface, sample_direct};
 
 /// Bounces after which Russian roulette starts. Mitsuba's default is 5;
 /// measured on 64x64 renders (callgrind instructions per sample times the
@@ -94,7 +95,7 @@ struct Walk<const N: usize> {
     bounces: u32,
     prev: Prev,
     /// The dielectric media the path is inside.
-    media: MediumStack,
+    media: VolumeStack,
 }
 
 impl PathTracer {
@@ -114,7 +115,7 @@ impl PathTracer {
             eta_scale: 1.0,
             bounces: 0,
             prev: Prev { p: ray.origin, pdf_bsdf: 0.0, delta: true },
-            media: scene.camera_media,
+            media: scene.camera_volumes,
         };
         self.walk(scene, ray, si, walk, lambdas, sampler, Start::Camera)
     }
@@ -136,35 +137,28 @@ impl PathTracer {
         let mut add_emission = start == Start::Camera;
         let mut passes = 0;
         loop {
-            let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
             // 0. Beer-Lambert absorption along the segment, in the medium it ran
             //    in (once: a split walk starts at a hit already counted).
-            if add_emission && let Some(sigma) = absorption(scene, w.media.current()) {
-                w.beta *= (lambdas.sample(sigma) * -hit.t).exp();
+            if add_emission && let Some(medium) = scene.medium_in(w.media.current()) {
+                w.beta *= medium.transmittance(hit.t, lambdas);
             }
             // 1. Emission, MIS-weighted against the light sample taken at the previous vertex.
-            if add_emission && let Some(index) = object.light {
-                let light = &scene.lights[index as usize];
-                let scale = light.le_scale(hit.n, ray.dir);
-                if scale > 0.0 {
-                    let weight = if w.prev.delta {
-                        1.0
-                    } else {
-                        let pdf_light = scene.light_pmf[index as usize] * light.pdf_li(w.prev.p, ray.dir, hit.p, hit.n);
-                        power_heuristic(w.prev.pdf_bsdf, pdf_light)
-                    };
-                    l += w.beta * lambdas.sample(light.spectrum()) * (scale * weight);
-                }
+            if add_emission && let Some(e) = scene.le(&si, ray.dir) {
+                let weight = if w.prev.delta {
+                    1.0
+                } else {
+                    power_heuristic(w.prev.pdf_bsdf, scene.pdf_li(e.light, w.prev.p, ray.dir, &si))
+                };
+                l += w.beta * lambdas.sample(e.radiance) * (e.scale * weight);
             }
             add_emission = true;
             // Nested dielectrics: a false intersection goes straight on.
             let at = interface(scene, &mut w.media, &si, ray.dir);
             if let Interface::Pass = at {
-                // Shadow rays stop at every surface, so light sampling never
-                // reaches past a false intersection: the BSDF sample there
-                // carries the full weight at an emitter beyond (no MIS).
-                w.prev.delta = true;
+                // The previous vertex's light sample reaches through false
+                // intersections too (`Scene::transmittance`), along the same
+                // straight line: an emitter beyond keeps its MIS weight.
                 passes += 1;
                 ray = Ray::spawn(hit.p, hit.n, ray.dir);
                 match scene.intersect(&ray, f32::INFINITY) {
@@ -178,7 +172,7 @@ impl PathTracer {
             if w.bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = &scene.materials[object.material as usize];
+            let bxdf = scene.bsdf(si.object);
             if bxdf.is_black() {
                 break;
             }
@@ -229,8 +223,7 @@ impl PathTracer {
             }
             // 4. Direct light.
             if !bxdf.is_delta() {
-                let surround = at.surround(scene, &w.media);
-                l += w.beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, true, w.bounces);
+                l += w.beta * sample_direct(scene, bxdf, &sh, &at, &w.media, lambdas, sampler, true, w.bounces);
             }
             // 5. The next direction.
             let (reads_u, reads_uc) = bxdf.reads_draws();

@@ -19,7 +19,7 @@ use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
 
-use super::{Interface, MAX_PASSES, Shading, absorption, interface, sample_direct};
+use super::{Interface, MAX_PASSES, Shading, interface, sample_direct};
 
 /// The Whitted integrator.
 #[derive(Clone, Copy, Debug)]
@@ -40,19 +40,17 @@ impl Whitted {
         let mut l = Sampled::<N>::splat(0.0);
         let mut beta = Sampled::<N>::splat(1.0);
         let mut bounces = 0;
-        let mut media = scene.camera_media;
+        let mut media = scene.camera_volumes;
         let mut passes = 0;
         while let Some(si) = scene.intersect(&ray, f32::INFINITY) {
-            let object = &scene.objects[si.object as usize];
             let hit = &si.hit;
             // Beer-Lambert absorption along the segment, in the medium it ran in.
-            if let Some(sigma) = absorption(scene, media.current()) {
-                beta *= (lambdas.sample(sigma) * -hit.t).exp();
+            if let Some(medium) = scene.medium_in(media.current()) {
+                beta *= medium.transmittance(hit.t, lambdas);
             }
             // Emitters seen directly or through specular surfaces only.
-            if let Some(index) = object.light {
-                let light = &scene.lights[index as usize];
-                l += beta * lambdas.sample(light.spectrum()) * light.le_scale(hit.n, ray.dir);
+            if let Some(e) = scene.le(&si, ray.dir) {
+                l += beta * lambdas.sample(e.radiance) * e.scale;
             }
             // Nested dielectrics: a false intersection goes straight on.
             let at = interface(scene, &mut media, &si, ray.dir);
@@ -68,15 +66,14 @@ impl Whitted {
             if bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = &scene.materials[object.material as usize];
+            let bxdf = scene.bsdf(si.object);
             if bxdf.is_black() {
                 break;
             }
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             if !bxdf.is_delta() {
                 // The diffuse end of E S* D L: direct light only, then stop.
-                let surround = at.surround(scene, &media);
-                l += beta * sample_direct(scene, bxdf, &sh, surround, lambdas, sampler, false, bounces);
+                l += beta * sample_direct(scene, bxdf, &sh, &at, &media, lambdas, sampler, false, bounces);
                 break;
             }
             let (reads_u, reads_uc) = bxdf.reads_draws();

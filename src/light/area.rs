@@ -17,6 +17,8 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+use super::EmissionSample;
+use super::emit::{surface_pdf_dir, surface_ray};
 use super::{LightSample, sides};
 use crate::color::Spectrum;
 use crate::shape::{Cuboid, Mesh, Quad};
@@ -174,6 +176,22 @@ impl AreaLight {
             return 0.0;
         }
         (point - p).length_squared() / (cos_l * self.area)
+    }
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl AreaLight {
+    /// A cosine-distributed ray from a point drawn uniformly by area.
+    #[inline]
+    pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let (point, n) = self.sample_point(u_pos);
+        surface_ray(point, n, self.area(), self.two_sided, u_dir)
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].
+    #[inline]
+    pub(super) fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        (1.0 / self.area(), surface_pdf_dir(n, dir, self.two_sided))
     }
 }
 

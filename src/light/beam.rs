@@ -11,8 +11,11 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::EmissionSample;
 use super::LightSample;
+use super::emit::parallel_ray;
 use crate::color::Spectrum;
+use glam::Vec2;
 
 /// A beam of parallel light from a disk.
 #[derive(Clone, Debug)]
@@ -48,6 +51,22 @@ impl BeamLight {
         }
         let point = self.origin + off_axis;
         Some(LightSample { wi: -self.direction, point, n: self.direction, pdf: 1.0, scale: 1.0, is_delta: true })
+    }
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl BeamLight {
+    /// A ray of the beam, from a uniform point of its disk.
+    #[inline]
+    pub(super) fn sample_le(&self, u_pos: Vec2) -> Option<EmissionSample> {
+        parallel_ray(self.origin, self.direction, self.radius, u_pos)
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`] (the
+    /// direction is a delta: its part is 1).
+    #[inline]
+    pub(super) fn pdf_le(&self) -> (f32, f32) {
+        (1.0 / (PI * self.radius * self.radius), 1.0)
     }
 }
 

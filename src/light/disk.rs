@@ -9,6 +9,8 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+use super::EmissionSample;
+use super::emit::{surface_pdf_dir, surface_ray};
 use super::{LightSample, sides};
 use crate::color::Spectrum;
 use crate::geometry::Frame;
@@ -70,5 +72,23 @@ impl DiskLight {
     #[inline]
     fn cos_emit(&self, wi: Vec3) -> f32 {
         if self.two_sided { wi.dot(self.disk.normal).abs() } else { -wi.dot(self.disk.normal) }
+    }
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl DiskLight {
+    /// A cosine-distributed ray from a uniform point of the disk.
+    #[inline]
+    pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let q = concentric_disk(u_pos) * self.disk.radius;
+        let point = self.disk.center + Frame::from_z(self.disk.normal).to_world(Vec3::new(q.x, q.y, 0.0));
+        let area = PI * self.disk.radius * self.disk.radius;
+        surface_ray(point, self.disk.normal, area, self.two_sided, u_dir)
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].
+    #[inline]
+    pub(super) fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        (1.0 / (PI * self.disk.radius * self.disk.radius), surface_pdf_dir(n, dir, self.two_sided))
     }
 }

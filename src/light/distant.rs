@@ -10,8 +10,11 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::EmissionSample;
 use super::LightSample;
+use super::emit::parallel_ray;
 use crate::color::Spectrum;
+use glam::Vec2;
 
 /// Parallel light travelling along `direction`.
 #[derive(Clone, Debug)]
@@ -40,5 +43,23 @@ impl DistantLight {
         let wi = -self.direction;
         let point = p + wi * (2.0 * self.scene_radius);
         Some(LightSample { wi, point, n: self.direction, pdf: 1.0, scale: 1.0, is_delta: true })
+    }
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl DistantLight {
+    /// A ray of the light's parallel bundle through the disk that covers the
+    /// scene's bounding sphere, facing the light's direction.
+    #[inline]
+    pub(super) fn sample_le(&self, u_pos: Vec2) -> Option<EmissionSample> {
+        let r = self.scene_radius;
+        parallel_ray(self.scene_center - self.direction * r, self.direction, r, u_pos)
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`] (the
+    /// direction is a delta: its part is 1).
+    #[inline]
+    pub(super) fn pdf_le(&self) -> (f32, f32) {
+        (1.0 / (PI * self.scene_radius * self.scene_radius), 1.0)
     }
 }

@@ -17,13 +17,16 @@
 //! position is in `pdf_pos`), for distant lights and beams the irradiance
 //! (the delta is in direction). [`Light::pdf_le`] gives both densities for a
 //! ray found otherwise, for the MIS weights of bidirectional path tracing.
+//! Each light's own `sample_le` and `pdf_le` live in its file; this file
+//! dispatches and holds the three ways of leaving a light that several share
+//! (a cosine ray from a surface point, and a ray of a parallel bundle).
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 use super::Light;
 use crate::geometry::Frame;
-use crate::sampler::warp::{concentric_disk, cosine_hemisphere, uniform_sphere};
+use crate::sampler::warp::{concentric_disk, cosine_hemisphere};
 
 /// A ray leaving a light.
 #[derive(Clone, Copy, Debug)]
@@ -62,60 +65,32 @@ impl Light {
         self.is_delta_position() || self.is_delta_direction()
     }
 
+    /// The emitted quantity from light point (normal `n`) towards `w`, as a
+    /// factor of [`Light::spectrum`], times the cosine at an area light (for
+    /// BDPT's connections to a light vertex; 0 for distant lights and beams,
+    /// which no connection can reach).
+    #[inline]
+    pub fn emit_factor(&self, n: Vec3, w: Vec3) -> f32 {
+        match self {
+            Light::Point(_) => 1.0,
+            Light::Spot(l) => l.falloff(w),
+            Light::Distant(_) | Light::Beam(_) => 0.0,
+            Light::Sphere(_) | Light::Disk(_) | Light::Area(_) => self.le_scale(n, -w) * w.dot(n).abs(),
+        }
+    }
+
     /// Samples a ray leaving the light with `u_pos` (the point) and `u_dir`
     /// (the direction). `None` when the light emits nothing.
     #[inline]
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
         match self {
-            Light::Point(l) => Some(EmissionSample {
-                point: l.position,
-                n: Vec3::ZERO,
-                dir: uniform_sphere(u_dir),
-                pdf_pos: 1.0,
-                pdf_dir: 1.0 / (4.0 * PI),
-                scale: 1.0,
-            }),
-            Light::Spot(l) => {
-                let one_minus_cos = 1.0 - l.cos_total;
-                if one_minus_cos <= 0.0 {
-                    return None;
-                }
-                let v = u_dir.x * one_minus_cos;
-                let cos = 1.0 - v;
-                let sin = (v * (2.0 - v)).max(0.0).sqrt();
-                let phi = 2.0 * PI * u_dir.y;
-                let dir = Frame::from_z(l.axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)).normalize();
-                let scale = l.falloff(dir);
-                (scale > 0.0).then_some(EmissionSample {
-                    point: l.position,
-                    n: Vec3::ZERO,
-                    dir,
-                    pdf_pos: 1.0,
-                    pdf_dir: 1.0 / (2.0 * PI * one_minus_cos),
-                    scale,
-                })
-            }
-            Light::Sphere(l) => {
-                let n = uniform_sphere(u_pos);
-                let point = l.sphere.center + n * l.sphere.radius;
-                let area = 4.0 * PI * l.sphere.radius * l.sphere.radius;
-                surface_ray(point, n, area, l.two_sided, u_dir)
-            }
-            Light::Disk(l) => {
-                let q = concentric_disk(u_pos) * l.disk.radius;
-                let point = l.disk.center + Frame::from_z(l.disk.normal).to_world(Vec3::new(q.x, q.y, 0.0));
-                let area = PI * l.disk.radius * l.disk.radius;
-                surface_ray(point, l.disk.normal, area, l.two_sided, u_dir)
-            }
-            Light::Area(l) => {
-                let (point, n) = l.sample_point(u_pos);
-                surface_ray(point, n, l.area(), l.two_sided, u_dir)
-            }
-            Light::Distant(l) => {
-                let r = l.scene_radius;
-                parallel_ray(l.scene_center - l.direction * r, l.direction, r, u_pos)
-            }
-            Light::Beam(l) => parallel_ray(l.origin, l.direction, l.radius, u_pos),
+            Light::Point(l) => l.sample_le(u_dir),
+            Light::Spot(l) => l.sample_le(u_dir),
+            Light::Sphere(l) => l.sample_le(u_pos, u_dir),
+            Light::Disk(l) => l.sample_le(u_pos, u_dir),
+            Light::Area(l) => l.sample_le(u_pos, u_dir),
+            Light::Distant(l) => l.sample_le(u_pos),
+            Light::Beam(l) => l.sample_le(u_pos),
         }
     }
 
@@ -126,25 +101,20 @@ impl Light {
     #[inline]
     pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
         match self {
-            Light::Point(_) => (1.0, 1.0 / (4.0 * PI)),
-            Light::Spot(l) => {
-                let inside = dir.dot(l.axis) >= l.cos_total && l.cos_total < 1.0;
-                (1.0, if inside { 1.0 / (2.0 * PI * (1.0 - l.cos_total)) } else { 0.0 })
-            }
-            Light::Sphere(l) => {
-                (1.0 / (4.0 * PI * l.sphere.radius * l.sphere.radius), surface_pdf_dir(n, dir, l.two_sided))
-            }
-            Light::Disk(l) => (1.0 / (PI * l.disk.radius * l.disk.radius), surface_pdf_dir(n, dir, l.two_sided)),
-            Light::Area(l) => (1.0 / l.area(), surface_pdf_dir(n, dir, l.two_sided)),
-            Light::Distant(l) => (1.0 / (PI * l.scene_radius * l.scene_radius), 1.0),
-            Light::Beam(l) => (1.0 / (PI * l.radius * l.radius), 1.0),
+            Light::Point(l) => l.pdf_le(),
+            Light::Spot(l) => l.pdf_le(dir),
+            Light::Sphere(l) => l.pdf_le(n, dir),
+            Light::Disk(l) => l.pdf_le(n, dir),
+            Light::Area(l) => l.pdf_le(n, dir),
+            Light::Distant(l) => l.pdf_le(),
+            Light::Beam(l) => l.pdf_le(),
         }
     }
 }
 
 /// A cosine-distributed ray from a point of an area light.
 #[inline]
-fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Option<EmissionSample> {
+pub(super) fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Option<EmissionSample> {
     if area.is_nan() || area <= 0.0 {
         return None;
     }
@@ -165,7 +135,7 @@ fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Opt
 
 /// The direction density of [`surface_ray`].
 #[inline]
-fn surface_pdf_dir(n: Vec3, dir: Vec3, two_sided: bool) -> f32 {
+pub(super) fn surface_pdf_dir(n: Vec3, dir: Vec3, two_sided: bool) -> f32 {
     let cos = dir.dot(n);
     if two_sided {
         0.5 * cos.abs() / PI
@@ -178,7 +148,7 @@ fn surface_pdf_dir(n: Vec3, dir: Vec3, two_sided: bool) -> f32 {
 
 /// A ray of a collimated disk of radius `r` centred at `center`, travelling along `dir`.
 #[inline]
-fn parallel_ray(center: Vec3, dir: Vec3, r: f32, u: Vec2) -> Option<EmissionSample> {
+pub(super) fn parallel_ray(center: Vec3, dir: Vec3, r: f32, u: Vec2) -> Option<EmissionSample> {
     if r.is_nan() || r <= 0.0 {
         return None;
     }

@@ -6,8 +6,9 @@
 //! `area` emitter, with radiance `L_e(λ)`, unless `two_sided: true`
 //! (pbrt-v4's `twosided`). The `lights:` list holds the delta lights: point
 //! and spot lights (intensity `I(λ)`), distant lights and beams (irradiance
-//! `E(λ)`). A new emitter is a new file here, a variant of [`Light`] and a
-//! case in the scene loader.
+//! `E(λ)`). A new emitter is a new file here (its sampling towards a point,
+//! `sample_li`/`pdf_li`, and away from it, `sample_le`/`pdf_le`), a variant of
+//! [`Light`] with an arm in each dispatching method, and a case in the scene loader.
 //!
 //! Every light answers the same questions: what it emits
 //! ([`Light::spectrum`]), how much ([`Light::power`], for choosing among

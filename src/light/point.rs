@@ -8,8 +8,11 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::EmissionSample;
 use super::LightSample;
 use crate::color::Spectrum;
+use crate::sampler::warp::uniform_sphere;
+use glam::Vec2;
 
 /// An isotropic point light of intensity `intensity` (W/sr/nm, arbitrary units).
 #[derive(Clone, Debug)]
@@ -43,4 +46,26 @@ pub(super) fn toward(position: Vec3, p: Vec3) -> Option<LightSample> {
         return None;
     }
     Some(LightSample { wi: d / d2.sqrt(), point: position, n: Vec3::ZERO, pdf: 1.0, scale: 1.0 / d2, is_delta: true })
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl PointLight {
+    /// A ray leaving the light in a uniform direction drawn with `u_dir`.
+    #[inline]
+    pub(super) fn sample_le(&self, u_dir: Vec2) -> Option<EmissionSample> {
+        Some(EmissionSample {
+            point: self.position,
+            n: Vec3::ZERO,
+            dir: uniform_sphere(u_dir),
+            pdf_pos: 1.0,
+            pdf_dir: 1.0 / (4.0 * PI),
+            scale: 1.0,
+        })
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].
+    #[inline]
+    pub(super) fn pdf_le(&self) -> (f32, f32) {
+        (1.0, 1.0 / (4.0 * PI))
+    }
 }

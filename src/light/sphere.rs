@@ -11,6 +11,8 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+use super::EmissionSample;
+use super::emit::{surface_pdf_dir, surface_ray};
 use super::{LightSample, sides};
 use crate::color::Spectrum;
 use crate::geometry::Frame;
@@ -106,4 +108,22 @@ impl SphereLight {
 fn cone_one_minus_cos(sin2_max: f32) -> f32 {
     let sin2 = sin2_max.min(1.0);
     sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt())
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl SphereLight {
+    /// A cosine-distributed ray from a uniform point of the sphere.
+    #[inline]
+    pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let n = uniform_sphere(u_pos);
+        let point = self.sphere.center + n * self.sphere.radius;
+        let area = 4.0 * PI * self.sphere.radius * self.sphere.radius;
+        surface_ray(point, n, area, self.two_sided, u_dir)
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].
+    #[inline]
+    pub(super) fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        (1.0 / (4.0 * PI * self.sphere.radius * self.sphere.radius), surface_pdf_dir(n, dir, self.two_sided))
+    }
 }

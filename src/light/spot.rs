@@ -10,9 +10,12 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::EmissionSample;
 use super::LightSample;
 use super::point::toward;
 use crate::color::Spectrum;
+use crate::geometry::Frame;
+use glam::Vec2;
 
 /// A spot light at `position` pointing along `axis`.
 #[derive(Clone, Debug)]
@@ -70,6 +73,40 @@ impl SpotLight {
         }
         ls.scale *= f;
         Some(ls)
+    }
+}
+
+/// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
+impl SpotLight {
+    /// A ray leaving the light in a direction drawn uniformly within its cone
+    /// with `u_dir`, carrying the falloff as its scale.
+    #[inline]
+    pub(super) fn sample_le(&self, u_dir: Vec2) -> Option<EmissionSample> {
+        let one_minus_cos = 1.0 - self.cos_total;
+        if one_minus_cos <= 0.0 {
+            return None;
+        }
+        let v = u_dir.x * one_minus_cos;
+        let cos = 1.0 - v;
+        let sin = (v * (2.0 - v)).max(0.0).sqrt();
+        let phi = 2.0 * PI * u_dir.y;
+        let dir = Frame::from_z(self.axis).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)).normalize();
+        let scale = self.falloff(dir);
+        (scale > 0.0).then_some(EmissionSample {
+            point: self.position,
+            n: Vec3::ZERO,
+            dir,
+            pdf_pos: 1.0,
+            pdf_dir: 1.0 / (2.0 * PI * one_minus_cos),
+            scale,
+        })
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`] for `dir`.
+    #[inline]
+    pub(super) fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
+        let inside = dir.dot(self.axis) >= self.cos_total && self.cos_total < 1.0;
+        (1.0, if inside { 1.0 / (2.0 * PI * (1.0 - self.cos_total)) } else { 0.0 })
     }
 }
 

@@ -342,7 +342,7 @@ pub struct ObjectDesc {
     pub two_sided: bool,
     /// For a dielectric object: which medium wins where its volume overlaps
     /// another's (default 0; higher wins; nested dielectrics, see
-    /// [`crate::bxdf::medium`]; ignored for other materials): `priority: 2`.
+    /// [`crate::medium::nested`]; ignored for other materials): `priority: 2`.
     #[serde(default)]
     pub priority: u32,
 }

@@ -9,14 +9,17 @@
 
 pub mod desc;
 mod load;
+mod query;
 mod spectra;
 
 pub use load::{load_scene, load_scene_str};
+pub use query::{Emitted, LightChoice, MAX_PASSES};
 
-use crate::bxdf::{Bxdf, MEDIUM_STACK_DEPTH, Medium, MediumStack};
+use crate::bxdf::Bxdf;
 use crate::camera::Camera;
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::light::Light;
+use crate::medium::{Medium, VOLUME_STACK_DEPTH, Volume, VolumeStack};
 use crate::settings::Settings;
 use crate::shape::Shape;
 use crate::shape::{Batch, Bvh};
@@ -40,7 +43,7 @@ pub struct Object {
     /// Index into [`Scene::lights`] when the object emits.
     pub light: Option<u32>,
     /// Where dielectric volumes overlap, the higher priority wins (nested
-    /// dielectrics, [`crate::bxdf::medium`]).
+    /// dielectrics, [`crate::medium::nested`]).
     pub priority: u32,
 }
 
@@ -67,13 +70,16 @@ pub struct Scene {
     light_cdf: Vec<f32>,
     /// The camera.
     pub camera: Camera,
-    /// The dielectric media the camera's eye is inside, where every camera
-    /// path starts ([`Scene::camera_media`]).
-    pub camera_media: MediumStack,
-    /// Dielectric media nest or overlap ([`Scene::has_nested_media`]).
+    /// The dielectric volumes the camera's eye is inside, where every camera
+    /// path starts ([`Scene::camera_volumes`]).
+    pub camera_volumes: VolumeStack,
+    /// Dielectric volumes nest or overlap ([`Scene::has_nested_volumes`]).
     nested: bool,
-    /// Some object is a dielectric ([`Scene::has_media`]).
-    media: bool,
+    /// Some object is a dielectric ([`Scene::has_volumes`]).
+    volumes: bool,
+    /// The medium inside each material's volume (index for index with
+    /// `materials`; `None`: clear, or not a dielectric).
+    media: Vec<Option<Medium>>,
     /// Render settings: the file's `render` block with command-line overrides applied.
     pub settings: Settings,
     /// Indices of bounded objects, in the BVH's order when there is one.
@@ -124,9 +130,10 @@ impl Scene {
         for l in &mut lights {
             l.set_scene_bounds(world.centroid(), radius);
         }
-        let camera_media = media_at(camera.eye(), &objects, &materials);
-        let nested = nested_media(&camera_media, &objects, &materials);
-        let media = objects.iter().any(|o| materials[o.material as usize].as_dielectric().is_some());
+        let camera_volumes = volumes_at(camera.eye(), &objects, &materials);
+        let nested = nested_volumes(&camera_volumes, &objects, &materials);
+        let volumes = objects.iter().any(|o| materials[o.material as usize].as_dielectric().is_some());
+        let media = materials.iter().map(|m| m.absorption().map(|s| Medium::absorbing(*s))).collect();
         let batch = Batch::new(bounded.iter().map(|&i| (i, &objects[i as usize].shape)));
         let bvh = (batch.is_none() && bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);
@@ -157,8 +164,9 @@ impl Scene {
             light_pmf,
             light_cdf,
             camera,
-            camera_media,
+            camera_volumes,
             nested,
+            volumes,
             media,
             settings,
             bounded,
@@ -239,34 +247,34 @@ impl Scene {
         Some((i, self.light_pmf[i]))
     }
 
-    /// The medium of object `object` when its material is a dielectric.
+    /// The volume inside object `object` when its material is a dielectric.
     #[inline]
-    pub fn medium(&self, object: u32) -> Option<Medium> {
+    pub fn volume(&self, object: u32) -> Option<Volume> {
         let o = &self.objects[object as usize];
         self.materials[o.material as usize].as_dielectric()?;
-        Some(Medium { object, priority: o.priority, material: o.material })
+        Some(Volume { object, priority: o.priority, material: o.material })
     }
 
-    /// True when dielectric media may nest or overlap, so that a path needs
-    /// the medium stack: the camera starts inside a dielectric, or two
+    /// True when dielectric volumes may nest or overlap, so that a path needs
+    /// the volume stack: the camera starts inside a dielectric, or two
     /// dielectric objects' bounds overlap (an unbounded one overlaps all).
-    /// Only then do connections of `bdpt` and `lighttrace` march through
-    /// false intersections (elsewhere one occlusion test suffices).
+    /// Only then does [`Scene::transmittance`] march through false
+    /// intersections (elsewhere one occlusion test suffices).
     #[inline]
-    pub fn has_nested_media(&self) -> bool {
+    pub fn has_nested_volumes(&self) -> bool {
         self.nested
     }
 
-    /// True when some object is a dielectric (a medium a path can be inside).
+    /// True when some object is a dielectric (a volume a path can be inside).
     #[inline]
-    pub fn has_media(&self) -> bool {
-        self.media
+    pub fn has_volumes(&self) -> bool {
+        self.volumes
     }
 
-    /// The dielectric media around point `p` (as [`Scene::camera_media`] is
+    /// The dielectric volumes around point `p` (as [`Scene::camera_volumes`] is
     /// for the eye): where a light subpath starts.
-    pub fn media_at(&self, p: glam::Vec3) -> MediumStack {
-        if self.media { media_at(p, &self.objects, &self.materials) } else { MediumStack::VACUUM }
+    pub fn volumes_at(&self, p: glam::Vec3) -> VolumeStack {
+        if self.volumes { volumes_at(p, &self.objects, &self.materials) } else { VolumeStack::VACUUM }
     }
 
     /// True when any material's direction depends on wavelength.
@@ -292,7 +300,7 @@ const PROBES: [[f32; 3]; 6] = [
     [0.42, -0.27, -0.87],
 ];
 
-/// The dielectric media a point is inside, the outermost first, as a
+/// The dielectric volumes a point is inside, the outermost first, as a
 /// camera path starts there. For each dielectric object, six rays from `p`
 /// find the object's nearest surface: `p` is inside when more of the probes
 /// that hit leave the object (along its outward normal) than enter it, which
@@ -301,10 +309,10 @@ const PROBES: [[f32; 3]; 6] = [
 /// outermost, entered first (so equal priorities nest by geometry: a camera
 /// in water inside glass is in the water).
 /// No allocation (BDPT asks at every light subpath's origin); beyond
-/// [`MEDIUM_STACK_DEPTH`] media the innermost are dropped, as a path's stack
+/// [`VOLUME_STACK_DEPTH`] volumes the innermost are dropped, as a path's stack
 /// drops them.
-fn media_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> MediumStack {
-    let mut found = [(0.0f32, Medium::default()); MEDIUM_STACK_DEPTH];
+fn volumes_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> VolumeStack {
+    let mut found = [(0.0f32, Volume::default()); VOLUME_STACK_DEPTH];
     let mut count = 0;
     for (i, o) in objects.iter().enumerate() {
         if materials[o.material as usize].as_dielectric().is_none() {
@@ -323,26 +331,26 @@ fn media_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> MediumStac
             }
         }
         if leave > enter {
-            let m = (nearest, Medium { object: i as u32, priority: o.priority, material: o.material });
-            // Keep the MEDIUM_STACK_DEPTH farthest surfaces, sorted farthest first.
+            let m = (nearest, Volume { object: i as u32, priority: o.priority, material: o.material });
+            // Keep the VOLUME_STACK_DEPTH farthest surfaces, sorted farthest first.
             let at = found[..count].partition_point(|f| f.0.total_cmp(&nearest).is_ge());
-            if at < MEDIUM_STACK_DEPTH {
-                found.copy_within(at..(count.min(MEDIUM_STACK_DEPTH - 1)), at + 1);
+            if at < VOLUME_STACK_DEPTH {
+                found.copy_within(at..(count.min(VOLUME_STACK_DEPTH - 1)), at + 1);
                 found[at] = m;
-                count = (count + 1).min(MEDIUM_STACK_DEPTH);
+                count = (count + 1).min(VOLUME_STACK_DEPTH);
             }
         }
     }
-    let mut stack = MediumStack::VACUUM;
+    let mut stack = VolumeStack::VACUUM;
     for &(_, m) in &found[..count] {
         stack.enter(m);
     }
     stack
 }
 
-/// Whether media nest ([`Scene::has_nested_media`]).
-fn nested_media(camera_media: &MediumStack, objects: &[Object], materials: &[Bxdf]) -> bool {
-    if !camera_media.is_empty() {
+/// Whether volumes nest ([`Scene::has_nested_volumes`]).
+fn nested_volumes(camera_volumes: &VolumeStack, objects: &[Object], materials: &[Bxdf]) -> bool {
+    if !camera_volumes.is_empty() {
         return true;
     }
     let glass: Vec<Option<Aabb>> = objects
@@ -370,7 +378,7 @@ mod tests {
             objects: [ {objects} ])"#
         );
         let scene = load_scene_str(&text, std::path::Path::new("t.ron"), &SettingsPatch::default()).unwrap();
-        scene.camera_media.entries().iter().map(|m| m.object).collect()
+        scene.camera_volumes.entries().iter().map(|m| m.object).collect()
     }
 
     /// The camera's starting media: inside a solid (outermost first, by

@@ -293,7 +293,7 @@ fn auto_picks_bdpt_among_nested_media() {
         scene.trim_end().trim_end_matches("])")
     );
     let loaded = rust_v::scene::load_scene_str(&lit, std::path::Path::new("t.ron"), &Default::default()).unwrap();
-    assert!(loaded.has_nested_media());
+    assert!(loaded.has_nested_volumes());
     let said = rust_v::integrator::describe(&loaded);
     assert!(said.starts_with("auto: ") && said.contains("bidirectional"), "{said}");
 }

@@ -3,17 +3,15 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::bxdf::{Crossing, MediumStack};
 use crate::color::Spectrum;
-use crate::geometry::Ray;
-use crate::integrator::{MAX_PASSES, absorption};
+use crate::medium::VolumeStack;
 use crate::sampler::{Dim, Sampler};
-use crate::scene::Scene;
+use crate::scene::{LightChoice, Scene};
 use crate::spectral::Lambdas;
 
 use super::mis::{Overrides, mis_weight};
 use super::vertex::{
-    Contrib, Kind, Vertex, Wavelength, connectible, emit_factor, is_dispersive, material, outside, pdf_at, pdf_light,
+    Contrib, Kind, Vertex, Wavelength, connectible, is_dispersive, material, outside, pdf_at, pdf_light,
     shading_correction, to_area,
 };
 use super::{Bdpt, Sub};
@@ -48,13 +46,13 @@ impl Bdpt {
         // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
         let c = match qs.kind {
             Kind::Light(i) => {
-                let light = &scene.lights[i as usize];
+                let light = scene.light(i);
                 if light.is_delta() {
                     // Point and spot lights are invisible to the camera in every
                     // integrator (path tracing cannot see them either).
                     return None;
                 }
-                let e = emit_factor(light, qs.sh.n, w) * importance;
+                let e = light.emit_factor(qs.sh.n, w) * importance;
                 if e.is_nan() || e <= 0.0 {
                     return None;
                 }
@@ -118,10 +116,10 @@ impl Bdpt {
         match s {
             0 => {
                 // The camera subpath ends on an emitter.
-                let Some(index) = scene.objects[object as usize].light else {
+                let Some(index) = scene.emitter(object) else {
                     return NONE;
                 };
-                let light = &scene.lights[index as usize];
+                let light = scene.light(index);
                 let dir = (pt.p() - ptm.p()).normalize();
                 let le = light.le_scale(pt.sh.n, dir);
                 if le <= 0.0 {
@@ -134,7 +132,7 @@ impl Bdpt {
                     Contrib::Full(pt.beta * *light.spectrum() * le)
                 };
                 let (pdf_pos, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
-                let pt_rev = scene.light_pmf[index as usize] * pdf_pos;
+                let pt_rev = scene.light_pmf(index) * pdf_pos;
                 let as_light = Vertex { kind: Kind::Light(index), ..*pt };
                 let ptm_rev = to_area(scene, pdf_dir, &as_light, ptm);
                 let overrides = Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 };
@@ -143,19 +141,16 @@ impl Bdpt {
             1 => {
                 // Next-event estimation: a fresh point on a light.
                 let (u_light, u) = (
-                    sampler.get_1d_if(scene.lights.len() > 1, Dim::light_choice(t as u32 - 2)),
+                    sampler.get_1d_if(scene.light_count() > 1, Dim::light_choice(t as u32 - 2)),
                     sampler.get_2d(Dim::light_sample(t as u32 - 2)),
                 );
                 if !connectible(scene, pt) {
                     return NONE;
                 }
-                let Some((index, pmf)) = scene.choose_light(u_light) else {
+                let Some(LightChoice { light: index, pmf, sample: ls }) = scene.sample_li(pt.p(), u_light, u) else {
                     return NONE;
                 };
-                let light = &scene.lights[index];
-                let Some(ls) = light.sample_li(pt.p(), u) else {
-                    return NONE;
-                };
+                let light = scene.light(index);
                 let wi = pt.sh.frame.to_local(ls.wi);
                 if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
@@ -181,7 +176,7 @@ impl Bdpt {
                 };
                 // The sampled light vertex, for the MIS weight.
                 let (pdf_pos, _) = light.pdf_le(ls.n, -ls.wi);
-                let y = Vertex::at_point(Kind::Light(index as u32), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
+                let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
                 let pt_rev = pdf_light(scene, &y, pt);
                 let ptm_rev = bxdf.pdf_within(wi, pt.sh.wo, &Lambdas::full(), out) * pt.g_prev;
                 let qs_rev = to_area(scene, bxdf.pdf_within(pt.sh.wo, wi, &Lambdas::full(), out), pt, &y);
@@ -264,38 +259,12 @@ pub(super) fn scale(c: Contrib, weight: f32, transmittance: Option<Spectrum>, wl
     }
 }
 
-/// The segment of a connection from vertex `v` to point `to`, starting in
-/// `media` (the media around `v` on the segment's side; `None` in a scene
-/// without dielectrics). `None` when something blocks it; else the
-/// segment's transmittance when it runs in an absorbing medium.
-///
-/// Among nested dielectrics a segment passes false intersections (surfaces
-/// the medium stack says are not interfaces here, at most [`MAX_PASSES`]);
-/// the medium it runs in does not change at them, so one Beer-Lambert factor
-/// of the current medium over the whole length is exact.
-pub(super) fn segment(scene: &Scene, v: &Vertex, media: Option<&MediumStack>, to: Vec3) -> Option<Option<Spectrum>> {
-    let (mut ray, mut t_max) = Ray::spawn_to(v.p(), v.sh.n, to);
-    match media {
-        Some(stack) if scene.has_nested_media() => {
-            let mut stack = *stack;
-            let mut passes = 0;
-            while let Some(si) = scene.intersect(&ray, t_max) {
-                let entering = ray.dir.dot(si.hit.n) < 0.0;
-                match scene.medium(si.object) {
-                    Some(m) if passes < MAX_PASSES && stack.crossing(m, entering) == Crossing::Pass => {
-                        stack.cross(m, entering);
-                        passes += 1;
-                        (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to);
-                    }
-                    _ => return None,
-                }
-            }
-        }
-        _ => {
-            if scene.occluded(&ray, t_max) {
-                return None;
-            }
-        }
-    }
-    Some(absorption(scene, media.and_then(|m| m.current())).map(|sigma| (*sigma * -(to - v.p()).length()).exp()))
+/// The segment of a connection from vertex `v` to point `to`, starting in the
+/// volumes `volumes` (those around `v` on the segment's side; `None` in a
+/// scene without dielectrics): [`Scene::transmittance`] over the full spectrum.
+/// `None` when something blocks it; else the transmittance when the segment
+/// runs in a medium.
+#[inline]
+pub(super) fn segment(scene: &Scene, v: &Vertex, volumes: Option<&VolumeStack>, to: Vec3) -> Option<Option<Spectrum>> {
+    scene.transmittance(v.p(), v.sh.n, volumes, to, &Lambdas::full())
 }

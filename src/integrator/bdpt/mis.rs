@@ -53,7 +53,7 @@ pub(super) fn mis_weight(scene: &Scene, camera: &[Vertex], t: usize, light: &[Ve
     };
     let light_delta = |i: usize| i + 1 != s && light[i].delta;
     let delta_light = match light.first().map(|v| v.kind) {
-        Some(Kind::Light(i)) => scene.lights[i as usize].is_delta(),
+        Some(Kind::Light(i)) => scene.light(i).is_delta(),
         _ => false,
     };
     let mut ri = 1.0f32;

@@ -69,9 +69,9 @@
 //! the fixed draw costs colour noise only where dispersion is.
 //!
 //! # Nested dielectrics
-//! Both walks carry a [`MediumStack`], as the path tracer's do: the camera
-//! subpath starts in [`Scene::camera_media`], a light subpath in the media
-//! around its origin ([`Scene::media_at`], probed per subpath, only in scenes
+//! Both walks carry a [`VolumeStack`], as the path tracer's do: the camera
+//! subpath starts in [`Scene::camera_volumes`], a light subpath in the volumes
+//! around its origin ([`Scene::volumes_at`], probed per subpath, only in scenes
 //! with a dielectric). A false intersection is no vertex: the walk goes
 //! straight on, and the next vertex's densities are those of the whole
 //! straight line. Each vertex remembers the medium outside its dielectric
@@ -95,10 +95,10 @@ use std::cell::RefCell;
 
 use glam::{Vec2, Vec3};
 
-use crate::bxdf::MediumStack;
 use crate::color::{Sampled, Spectrum};
 use crate::film::Splat;
 use crate::geometry::Ray;
+use crate::medium::VolumeStack;
 use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
@@ -131,26 +131,26 @@ pub struct Bdpt {
 struct Paths {
     camera: Vec<Vertex>,
     light: Vec<Vertex>,
-    camera_media: Vec<MediumStack>,
-    light_media: Vec<MediumStack>,
+    camera_media: Vec<VolumeStack>,
+    light_media: Vec<VolumeStack>,
 }
 
 /// One subpath and its vertices' medium stacks.
 #[derive(Clone, Copy)]
 struct Sub<'p> {
     v: &'p [Vertex],
-    media: &'p [MediumStack],
+    media: &'p [VolumeStack],
 }
 
 impl Sub<'_> {
     /// The media around vertex `i` on the side of world direction `w` (None
     /// in a scene without dielectrics).
     #[inline]
-    fn media_towards(&self, scene: &Scene, i: usize, w: Vec3) -> Option<MediumStack> {
+    fn media_towards(&self, scene: &Scene, i: usize, w: Vec3) -> Option<VolumeStack> {
         let mut media = *self.media.get(i)?;
         let v = &self.v[i];
         if let Kind::Surface(o) = v.kind
-            && let Some(m) = scene.medium(o)
+            && let Some(m) = scene.volume(o)
             && w.dot(v.sh.n) * v.sh.wo_n < 0.0
         {
             // Across the surface from where the subpath arrived.
@@ -180,7 +180,7 @@ impl Estimator for Bdpt {
             light.clear();
             camera_media.clear();
             light_media.clear();
-            let track = scene.has_media();
+            let track = scene.has_volumes();
             let mut wl = Wavelength { u: sampler.get_1d(Dim::wavelength(0)), continuous: O::CONTINUOUS, drawn: None };
             let full = Lambdas::full();
             let (mut l, mut l_single) = (Spectrum::ZERO, 0.0f32);
@@ -229,18 +229,18 @@ impl Bdpt {
         film: Vec2,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
-        mut stacks: Option<&mut Vec<MediumStack>>,
+        mut stacks: Option<&mut Vec<VolumeStack>>,
         wl: &mut Wavelength,
     ) {
         let cam = &scene.camera;
         let ray = cam.ray(film);
         path.push(Vertex::at_point(Kind::Camera, ray.origin, cam.forward(), Spectrum::ONE, 1.0));
         if let Some(stacks) = stacks.as_deref_mut() {
-            stacks.push(scene.camera_media);
+            stacks.push(scene.camera_volumes);
         }
         let pdf_dir = cam.pdf_dir(ray.dir);
         let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2 };
-        walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_media, wl);
+        walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_volumes, wl);
     }
 
     /// A light by power, a ray leaving it, and its walk.
@@ -249,15 +249,15 @@ impl Bdpt {
         scene: &Scene,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
-        mut stacks: Option<&mut Vec<MediumStack>>,
+        mut stacks: Option<&mut Vec<VolumeStack>>,
         wl: &mut Wavelength,
     ) {
-        let u_light = sampler.get_1d_if(scene.lights.len() > 1, Dim::EMIT_CHOICE);
+        let u_light = sampler.get_1d_if(scene.light_count() > 1, Dim::EMIT_CHOICE);
         let (u_pos, u_dir) = (sampler.get_2d(Dim::EMIT_POSITION), sampler.get_2d(Dim::EMIT_DIRECTION));
         let Some((index, pmf)) = scene.choose_light(u_light) else {
             return;
         };
-        let light = &scene.lights[index];
+        let light = scene.light(index as u32);
         let Some(e) = light.sample_le(u_pos, u_dir) else {
             return;
         };
@@ -267,7 +267,7 @@ impl Bdpt {
         }
         let beta0 = *light.spectrum() / pdf_origin;
         path.push(Vertex::at_point(Kind::Light(index as u32), e.point, e.n, beta0, pdf_origin));
-        let media = scene.media_at(e.point);
+        let media = scene.volumes_at(e.point);
         if let Some(stacks) = stacks.as_deref_mut() {
             stacks.push(media);
         }

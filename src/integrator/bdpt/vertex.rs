@@ -8,7 +8,6 @@ use glam::Vec3;
 use crate::bxdf::{Bxdf, Outside};
 use crate::color::{N_BINS, Spectrum};
 use crate::geometry::Frame;
-use crate::light::Light;
 use crate::scene::Scene;
 use crate::spectral::{BinDistribution, Lambdas, Readout, bin_importance, continuous_wavelength};
 
@@ -71,7 +70,7 @@ impl Vertex {
     pub(super) fn on_surface(&self, scene: &Scene) -> bool {
         match self.kind {
             Kind::Surface(_) => true,
-            Kind::Light(i) => !scene.lights[i as usize].is_delta(),
+            Kind::Light(i) => !scene.light(i).is_delta(),
             Kind::Camera => false,
         }
     }
@@ -142,7 +141,7 @@ pub(super) fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 
 /// The material of object `o`.
 #[inline]
 pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
-    &scene.materials[scene.objects[o as usize].material as usize]
+    scene.bsdf(o)
 }
 
 /// True when a connection can end at `v`: a surface whose material has a
@@ -164,25 +163,10 @@ pub(super) fn is_dispersive(scene: &Scene, v: &Vertex) -> bool {
     matches!(v.kind, Kind::Surface(o) if material(scene, o).dispersion_within(outside(scene, v.outside)).is_some())
 }
 
-/// The emitted quantity from light point (normal `n`) towards `w`, as a
-/// factor of the light's spectrum, times the cosine at an area light.
-#[inline]
-pub(super) fn emit_factor(light: &Light, n: Vec3, w: Vec3) -> f32 {
-    match light {
-        Light::Point(_) => 1.0,
-        Light::Spot(l) => l.falloff(w),
-        Light::Distant(_) | Light::Beam(_) => 0.0,
-        Light::Sphere(_) | Light::Disk(_) | Light::Area(_) => light.le_scale(n, -w) * w.dot(n).abs(),
-    }
-}
-
 /// The medium outside a dielectric vertex, from its material index.
 #[inline]
 pub(super) fn outside(scene: &Scene, material: Option<u32>) -> Outside<'_> {
-    match material.and_then(|m| scene.materials[m as usize].as_dielectric()) {
-        Some(d) => Outside::medium(d),
-        None => Outside::VACUUM,
-    }
+    scene.outside(material)
 }
 
 /// Converts a density per solid angle at `from` towards `to` into a density
@@ -218,7 +202,7 @@ pub(super) fn pdf_light(scene: &Scene, y: &Vertex, next: &Vertex) -> f32 {
     let Kind::Light(i) = y.kind else {
         return 0.0;
     };
-    let light = &scene.lights[i as usize];
+    let light = scene.light(i);
     let w = (next.p() - y.p()).normalize_or_zero();
     let (pdf_pos, pdf_dir) = light.pdf_le(y.sh.n, w);
     if light.is_delta_direction() {

@@ -1,10 +1,10 @@
 //! Extending a subpath by BSDF sampling (radiance transport on the camera
 //! side, importance transport on the light side).
 
-use crate::bxdf::{Crossing, MediumStack};
 use crate::color::Spectrum;
 use crate::geometry::Ray;
-use crate::integrator::{MAX_PASSES, Shading, absorption};
+use crate::integrator::{MAX_PASSES, Shading};
+use crate::medium::{Crossing, VolumeStack};
 use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::Lambdas;
@@ -34,8 +34,8 @@ impl Walk {
         mut parallel: bool,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
-        mut stacks: Option<&mut Vec<MediumStack>>,
-        mut media: MediumStack,
+        mut stacks: Option<&mut Vec<VolumeStack>>,
+        mut media: VolumeStack,
         wl: &mut Wavelength,
     ) {
         let full = Lambdas::full();
@@ -53,12 +53,12 @@ impl Walk {
             let hit = si.hit;
             let bxdf = material(scene, si.object);
             // Beer-Lambert along the segment, in the medium it ran in.
-            if let Some(sigma) = absorption(scene, media.current()) {
+            if let Some(medium) = scene.medium_in(media.current()) {
                 if collapsed {
                     let one = wl.single();
-                    beta[one.slot] *= (-one.lambdas.sample(sigma)[0] * hit.t).exp();
+                    beta[one.slot] *= medium.transmittance(hit.t, &one.lambdas)[0];
                 } else {
-                    beta *= (*sigma * -hit.t).exp();
+                    beta *= medium.transmittance(hit.t, &full);
                 }
             }
             // Nested dielectrics: a false intersection is no vertex; the walk
@@ -66,7 +66,7 @@ impl Walk {
             let arrival = media;
             let mut crossing = None;
             let mut outside_material = None;
-            if let Some(m) = scene.medium(si.object) {
+            if let Some(m) = scene.volume(si.object) {
                 let entering = ray.dir.dot(hit.n) < 0.0;
                 match media.crossing(m, entering) {
                     Crossing::Pass => {

@@ -1,23 +1,24 @@
-//! Nested dielectrics: the medium stack a path carries, so that a surface
+//! Nested dielectrics: the stack of volumes a path carries, so that a surface
 //! between water and glass refracts with `n_water / n_glass` and not as if
 //! each met vacuum (after the idea of Schmidt and Budge 2002, "Simple nested
 //! dielectrics in ray traced images"; written for rust-v, neither pbrt-v4 nor
 //! Mitsuba 3 has it).
 //!
-//! Every object whose material is a [`super::Dielectric`] (smooth or rough,
-//! dispersive or not) is a *medium*: its inside (the side opposite its
-//! geometric normal) holds its index and its absorption. A path keeps the
-//! media it is inside in a [`MediumStack`]: a fixed array of
-//! [`MEDIUM_STACK_DEPTH`] entries (object, priority, material), no
+//! Every object whose material is a [`crate::bxdf::Dielectric`] (smooth or rough,
+//! dispersive or not) bounds a *volume*: its inside (the side opposite its
+//! geometric normal) holds its index and its medium (an absorbing
+//! [`super::Medium`] or nothing). A path keeps the
+//! volumes it is inside in a [`VolumeStack`]: a fixed array of
+//! [`VOLUME_STACK_DEPTH`] entries (object, priority, material), no
 //! allocation. Vacuum (index 1) is the bottom and is not stored.
 //!
-//! - The **current medium** is the entry of highest `priority`; among equal
+//! - The **current volume** is the entry of highest `priority`; among equal
 //!   priorities the one entered last (so glass and water of equal priority
 //!   nest the natural way: the water, entered after the glass, is inside it).
-//!   Segments are absorbed by the current medium's `absorption:`.
-//! - At a hit on a medium's surface, entering or leaving is decided by the
+//!   Segments are absorbed by the current volume's `absorption:`.
+//! - At a hit on a volume's surface, entering or leaving is decided by the
 //!   geometric normal. The surface is a real interface when its object would
-//!   be the current medium on its inside; its **outside** is the current
+//!   be the current volume on its inside; its **outside** is the current
 //!   medium of the stack without this object, and the relative index is
 //!   `n_object / n_outside` per wavelength.
 //! - Otherwise the hit is a **false intersection** (a lower-priority object
@@ -40,21 +41,21 @@
 //!
 //! **Inconsistent geometry** never panics: leaving an object that is not on
 //! the stack (an open mesh, a path that started inside glass the camera
-//! probe did not find) refracts into the current medium and leaves the stack
+//! probe did not find) refracts into the current volume and leaves the stack
 //! as it is; entering an object already on the stack does not record it
-//! twice. **Overflow**: a path inside more than [`MEDIUM_STACK_DEPTH`]
+//! twice. **Overflow**: a path inside more than [`VOLUME_STACK_DEPTH`]
 //! media at once does not record the innermost ones (entering them
 //! refracts as usual, but the stack keeps its 8 outer entries, so surfaces
 //! inside them take the 8th as their outside).
 
 /// How many media a path can be inside at once (vacuum not counted).
-pub const MEDIUM_STACK_DEPTH: usize = 8;
+pub const VOLUME_STACK_DEPTH: usize = 8;
 
 /// One medium a path is inside: the object whose volume it is, its
 /// priority, and its material (a dielectric, by index into the scene's
 /// materials).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct Medium {
+pub struct Volume {
     /// The object's index in the scene.
     pub object: u32,
     /// Its priority (higher wins where volumes overlap).
@@ -63,7 +64,7 @@ pub struct Medium {
     pub material: u32,
 }
 
-/// What a path meets at a medium's surface.
+/// What a path meets at a volume's surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Crossing {
     /// A real interface: scatter with the relative index `n_object /
@@ -79,25 +80,25 @@ pub enum Crossing {
 
 /// The media a path is inside, innermost last (fixed size, `Copy`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MediumStack {
-    entries: [Medium; MEDIUM_STACK_DEPTH],
+pub struct VolumeStack {
+    entries: [Volume; VOLUME_STACK_DEPTH],
     len: u8,
 }
 
-impl Default for MediumStack {
+impl Default for VolumeStack {
     fn default() -> Self {
-        MediumStack::VACUUM
+        VolumeStack::VACUUM
     }
 }
 
-impl MediumStack {
+impl VolumeStack {
     /// Vacuum: no medium.
-    pub const VACUUM: MediumStack =
-        MediumStack { entries: [Medium { object: 0, priority: 0, material: 0 }; MEDIUM_STACK_DEPTH], len: 0 };
+    pub const VACUUM: VolumeStack =
+        VolumeStack { entries: [Volume { object: 0, priority: 0, material: 0 }; VOLUME_STACK_DEPTH], len: 0 };
 
     /// The recorded media, outermost first.
     #[inline]
-    pub fn entries(&self) -> &[Medium] {
+    pub fn entries(&self) -> &[Volume] {
         &self.entries[..self.len as usize]
     }
 
@@ -107,7 +108,7 @@ impl MediumStack {
         self.len == 0
     }
 
-    /// The position of the current medium among the entries other than
+    /// The position of the current volume among the entries other than
     /// `object`'s: highest priority, the last entered among equals.
     #[inline]
     fn current_index(&self, except: Option<u32>) -> Option<usize> {
@@ -122,7 +123,7 @@ impl MediumStack {
 
     /// The medium the path is in now (`None`: vacuum).
     #[inline]
-    pub fn current(&self) -> Option<Medium> {
+    pub fn current(&self) -> Option<Volume> {
         if self.len == 0 {
             return None;
         }
@@ -132,7 +133,7 @@ impl MediumStack {
     /// What a hit on the surface of medium `m` is, for a path `entering`
     /// it (arriving against the geometric normal) or leaving it.
     #[inline]
-    pub fn crossing(&self, m: Medium, entering: bool) -> Crossing {
+    pub fn crossing(&self, m: Volume, entering: bool) -> Crossing {
         let Some(best) = self.current_index(Some(m.object)) else {
             return Crossing::Interface { outside: None };
         };
@@ -149,9 +150,9 @@ impl MediumStack {
 
     /// The path enters `m`: recorded unless already there or the stack is full.
     #[inline]
-    pub fn enter(&mut self, m: Medium) {
+    pub fn enter(&mut self, m: Volume) {
         let n = self.len as usize;
-        if n < MEDIUM_STACK_DEPTH && !self.entries().iter().any(|e| e.object == m.object) {
+        if n < VOLUME_STACK_DEPTH && !self.entries().iter().any(|e| e.object == m.object) {
             self.entries[n] = m;
             self.len += 1;
         }
@@ -169,7 +170,7 @@ impl MediumStack {
 
     /// The path crosses the surface of `m`, entering or leaving it.
     #[inline]
-    pub fn cross(&mut self, m: Medium, entering: bool) {
+    pub fn cross(&mut self, m: Volume, entering: bool) {
         if entering { self.enter(m) } else { self.leave(m.object) }
     }
 }
@@ -178,8 +179,8 @@ impl MediumStack {
 mod tests {
     use super::*;
 
-    fn m(object: u32, priority: u32) -> Medium {
-        Medium { object, priority, material: 10 + object }
+    fn m(object: u32, priority: u32) -> Volume {
+        Volume { object, priority, material: 10 + object }
     }
 
     /// Glass and water of equal priority, water inside: every surface sees
@@ -187,7 +188,7 @@ mod tests {
     #[test]
     fn equal_priorities_nest_in_entry_order() {
         let (glass, water) = (m(1, 0), m(2, 0));
-        let mut s = MediumStack::VACUUM;
+        let mut s = VolumeStack::VACUUM;
         assert_eq!(s.crossing(glass, true), Crossing::Interface { outside: None });
         s.cross(glass, true);
         assert_eq!(s.current(), Some(glass));
@@ -206,7 +207,7 @@ mod tests {
     #[test]
     fn lower_priority_inside_higher_is_a_false_intersection() {
         let (outer, inner) = (m(1, 5), m(2, 1));
-        let mut s = MediumStack::VACUUM;
+        let mut s = VolumeStack::VACUUM;
         s.cross(outer, true);
         assert_eq!(s.crossing(inner, true), Crossing::Pass);
         s.cross(inner, true);
@@ -215,7 +216,7 @@ mod tests {
         // Leaving the outer medium while still inside the inner one: the inner is the outside.
         assert_eq!(s.crossing(outer, false), Crossing::Interface { outside: Some(12) });
         // Equal priority, the other entered later: leaving the earlier is false.
-        let mut t = MediumStack::VACUUM;
+        let mut t = VolumeStack::VACUUM;
         t.cross(m(1, 0), true);
         t.cross(m(2, 0), true);
         assert_eq!(t.crossing(m(1, 0), false), Crossing::Pass);
@@ -225,7 +226,7 @@ mod tests {
     /// the stack keep it consistent and never panic.
     #[test]
     fn inconsistent_geometry_and_overflow() {
-        let mut s = MediumStack::VACUUM;
+        let mut s = VolumeStack::VACUUM;
         assert_eq!(s.crossing(m(3, 0), false), Crossing::Interface { outside: None });
         s.cross(m(3, 0), false);
         assert!(s.is_empty());
@@ -235,12 +236,12 @@ mod tests {
         for i in 2..20 {
             s.cross(m(i, 0), true);
         }
-        assert_eq!(s.entries().len(), MEDIUM_STACK_DEPTH);
+        assert_eq!(s.entries().len(), VOLUME_STACK_DEPTH);
         assert_eq!(s.current(), Some(m(8, 0)));
         // The unrecorded ninth: leaving it is a real interface into the 8th, and changes nothing.
         assert_eq!(s.crossing(m(9, 0), false), Crossing::Interface { outside: Some(18) });
         s.cross(m(9, 0), false);
-        assert_eq!(s.entries().len(), MEDIUM_STACK_DEPTH);
+        assert_eq!(s.entries().len(), VOLUME_STACK_DEPTH);
         s.cross(m(4, 0), false);
         assert_eq!(s.entries().iter().map(|e| e.object).collect::<Vec<_>>(), [1, 2, 3, 5, 6, 7, 8]);
     }

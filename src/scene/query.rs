@@ -1,0 +1,196 @@
+//! The door between the integrators and the scene: every question a
+//! light-transport method asks of what a scene contains. No integrator reads
+//! the scene's objects, materials or lights directly, and none names a light
+//! or material variant; each asks here, and the rooms that answer (shapes,
+//! [`crate::bxdf`] lobes, [`crate::light`], [`crate::medium`]) stay closed
+//! enums with their verbs in their own files.
+//!
+//! | question | query |
+//! |---|---|
+//! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: hit, uv, normals, object) |
+//! | the BSDF at a surface | [`Scene::bsdf`] |
+//! | emission leaving a surface hit | [`Scene::le`], and its light-sampling density for MIS, [`Scene::pdf_li`] |
+//! | a point on a light towards a shading point | [`Scene::sample_li`] |
+//! | a ray leaving a light (BDPT, light tracing) | [`Scene::light`] then [`crate::light::Light::sample_le`] |
+//! | the volume a dielectric's surface bounds, and the medium inside | [`Scene::volume`], [`Scene::medium_in`] |
+//! | whether a segment between two points is clear, and its attenuation | [`Scene::transmittance`]: the one visibility rule |
+//!
+//! A ray that escapes the scene meets nothing today: no infinite light exists
+//! yet. The integrators' escape branches (`path.rs`, `whitted.rs`, and
+//! `bdpt/walk.rs`) are where an environment light will answer, through a
+//! query added here.
+
+use glam::Vec3;
+
+use super::{Scene, SurfaceHit};
+use crate::bxdf::{Bxdf, Outside};
+use crate::color::{Sampled, Spectrum};
+use crate::geometry::Ray;
+use crate::light::{Light, LightSample};
+use crate::medium::{Crossing, Medium, Volume, VolumeStack};
+use crate::spectral::Lambdas;
+
+/// The most false intersections a path or a segment passes in a row before it
+/// ends (a guard against degenerate geometry; real scenes need a handful).
+pub const MAX_PASSES: u32 = 64;
+
+/// Emission leaving a surface hit towards the ray's origin.
+#[derive(Clone, Copy, Debug)]
+pub struct Emitted<'a> {
+    /// The light the surface belongs to.
+    pub light: u32,
+    /// Its emitted radiance.
+    pub radiance: &'a Spectrum,
+    /// The factor of `radiance` leaving towards the ray (1, or 0 from the back
+    /// of a one-sided emitter: then [`Scene::le`] answers `None`).
+    pub scale: f32,
+}
+
+/// A point on a light chosen for next-event estimation.
+#[derive(Clone, Copy, Debug)]
+pub struct LightChoice {
+    /// Which light.
+    pub light: u32,
+    /// The probability of having chosen it.
+    pub pmf: f32,
+    /// The direction, point and density on it.
+    pub sample: LightSample,
+}
+
+impl Scene {
+    /// The BSDF of object `object`'s material.
+    #[inline]
+    pub fn bsdf(&self, object: u32) -> &Bxdf {
+        &self.materials[self.objects[object as usize].material as usize]
+    }
+
+    /// The medium outside a dielectric surface whose outside volume has
+    /// material `material` (`None`: vacuum), as the lobes take it.
+    #[inline]
+    pub fn outside(&self, material: Option<u32>) -> Outside<'_> {
+        match material.and_then(|m| self.materials[m as usize].as_dielectric()) {
+            Some(d) => Outside::medium(d),
+            None => Outside::VACUUM,
+        }
+    }
+
+    /// The medium filling `volume` (`None`: vacuum, or a clear volume).
+    #[inline]
+    pub fn medium_in(&self, volume: Option<Volume>) -> Option<&Medium> {
+        self.media[volume?.material as usize].as_ref()
+    }
+
+    /// The light of object `object`, when it emits.
+    #[inline]
+    pub fn emitter(&self, object: u32) -> Option<u32> {
+        self.objects[object as usize].light
+    }
+
+    /// Light `index`.
+    #[inline]
+    pub fn light(&self, index: u32) -> &Light {
+        &self.lights[index as usize]
+    }
+
+    /// How many lights the scene has (area lights included).
+    #[inline]
+    pub fn light_count(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// The probability with which next-event estimation chooses light `index`.
+    #[inline]
+    pub fn light_pmf(&self, index: u32) -> f32 {
+        self.light_pmf[index as usize]
+    }
+
+    /// True when some light is a delta light (point, spot, distant, beam):
+    /// no ray can hit it.
+    pub fn has_delta_light(&self) -> bool {
+        self.lights.iter().any(Light::is_delta)
+    }
+
+    /// True when some object's material scatters only into delta directions
+    /// (smooth glass, mirror, smooth metal, thin sheet).
+    pub fn has_delta_surface(&self) -> bool {
+        self.objects.iter().any(|o| self.materials[o.material as usize].is_delta())
+    }
+
+    /// The emission leaving surface hit `si` back along `dir` (the direction
+    /// the ray travelled), or `None` where nothing leaves that side.
+    #[inline]
+    pub fn le(&self, si: &SurfaceHit, dir: Vec3) -> Option<Emitted<'_>> {
+        let index = self.emitter(si.object)?;
+        let light = &self.lights[index as usize];
+        let scale = light.le_scale(si.hit.n, dir);
+        (scale > 0.0).then_some(Emitted { light: index, radiance: light.spectrum(), scale })
+    }
+
+    /// The density per unit solid angle with which [`Scene::sample_li`] from
+    /// `from` would have produced direction `dir`, which reaches light
+    /// `light` at surface hit `si` (the light's choice included).
+    #[inline]
+    pub fn pdf_li(&self, light: u32, from: Vec3, dir: Vec3, si: &SurfaceHit) -> f32 {
+        self.light_pmf[light as usize] * self.lights[light as usize].pdf_li(from, dir, si.hit.p, si.hit.n)
+    }
+
+    /// Next-event estimation from point `p`: a light chosen by power with
+    /// `u_light`, then a point on it with `u`.
+    #[inline(always)]
+    pub fn sample_li(&self, p: Vec3, u_light: f32, u: glam::Vec2) -> Option<LightChoice> {
+        let (index, pmf) = self.choose_light(u_light)?;
+        let sample = self.lights[index].sample_li(p, u)?;
+        Some(LightChoice { light: index as u32, pmf, sample })
+    }
+
+    /// The one visibility rule, for shadow rays and connections of every
+    /// integrator: whether the segment from surface point `p` (geometric
+    /// normal `n`) to `to` is clear, and its transmittance at the packet's
+    /// wavelengths. `volumes` are the volumes around `p` on the segment's
+    /// side (`None` in a scene without dielectrics).
+    ///
+    /// Where dielectric volumes nest, the segment passes false
+    /// intersections (surfaces the stack says are not interfaces here, at
+    /// most [`MAX_PASSES`]); any other surface blocks it. The current volume
+    /// does not change at a false intersection, so the medium `p`'s side is
+    /// filled with attenuates the whole length, once (Beer-Lambert,
+    /// [`Medium::transmittance`]). `None` when blocked; `Some(None)` when
+    /// clear and unattenuated (vacuum or a clear volume), so callers multiply
+    /// only by a real transmittance.
+    #[inline]
+    pub fn transmittance<const N: usize>(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        volumes: Option<&VolumeStack>,
+        to: Vec3,
+        lambdas: &Lambdas<N>,
+    ) -> Option<Option<Sampled<N>>> {
+        let (mut ray, mut t_max) = Ray::spawn_to(p, n, to);
+        match volumes {
+            Some(stack) if self.nested => {
+                let mut stack = *stack;
+                let mut passes = 0;
+                while let Some(si) = self.intersect(&ray, t_max) {
+                    let entering = ray.dir.dot(si.hit.n) < 0.0;
+                    match self.volume(si.object) {
+                        Some(v) if passes < MAX_PASSES && stack.crossing(v, entering) == Crossing::Pass => {
+                            stack.cross(v, entering);
+                            passes += 1;
+                            (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to);
+                        }
+                        _ => return None,
+                    }
+                }
+            }
+            _ => {
+                if self.occluded(&ray, t_max) {
+                    return None;
+                }
+            }
+        }
+        Some(
+            self.medium_in(volumes.and_then(VolumeStack::current)).map(|m| m.transmittance((to - p).length(), lambdas)),
+        )
+    }
+}
