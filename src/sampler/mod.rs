@@ -40,6 +40,14 @@
 //! | [`Dim::EMIT_CHOICE`], [`Dim::EMIT_POSITION`], [`Dim::EMIT_DIRECTION`] | 1D, 2D, 2D | BDPT's light subpath: the light, a point and a direction leaving it |
 //! | `d.`[`on_light_path`](Dim::on_light_path)`()` | as `d` | a per-bounce draw on BDPT's light subpath (its own block) |
 //!
+//! A bounce's block has 8 slots and uses 7; **slot 7 is kept for a
+//! participating medium's distance draw** (1D) at that depth. A vertex
+//! scatters once, at a surface or in a medium, so a medium vertex takes its
+//! phase-function direction from the [`Dim::bsdf`] slot of its depth and its
+//! light sample from the same next-event slots as a surface vertex (pbrt-v4's
+//! `volpath` shares its sampler dimensions the same way). Media need no other
+//! room, and adding them changes no existing draw.
+//!
 //! The walks a packet splits into at a dispersive surface continue with the
 //! same per-bounce draws (their numbers are shared, as a hero packet shares
 //! its directions; each walk's estimate stays unbiased, and so does their sum).
