@@ -428,7 +428,7 @@ pub fn default_checkpoint_path(output: &Path) -> PathBuf {
 mod tests {
     use super::*;
     use crate::color::Xyz;
-    use crate::film::tiles;
+    use crate::render::tiles;
 
     fn sample() -> Checkpoint {
         let mut film = Film::new(5, 3);

@@ -102,7 +102,9 @@ pub(crate) struct Splat<S> {
     pub value: S,
 }
 
-/// A rectangle of pixels `[x0, x1) × [y0, y1)`.
+/// A rectangle of pixels `[x0, x1) × [y0, y1)`: what the film adds a buffer of
+/// samples to. The scheduler (`crate::render::tiles`) decides how an image is
+/// cut into them and in what order they run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Tile {
     /// First column.
@@ -120,17 +122,6 @@ impl Tile {
     pub fn len(&self) -> usize {
         ((self.x1 - self.x0) * (self.y1 - self.y0)) as usize
     }
-}
-
-/// Splits a `width × height` image into tiles of at most `size × size`, row-major.
-pub(crate) fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
-    let mut out = Vec::new();
-    for y0 in (0..height).step_by(size as usize) {
-        for x0 in (0..width).step_by(size as usize) {
-            out.push(Tile { x0, y0, x1: (x0 + size).min(width), y1: (y0 + size).min(height) });
-        }
-    }
-    out
 }
 
 /// Per-pixel XYZ sums (fixed point, see the module docs) over a contiguous
@@ -328,7 +319,7 @@ impl Film {
     }
 
     /// Adds whole passes of samples of `tiles` (row-major tiles of edge
-    /// `tile_size`, as [`tiles`] makes them), and splats: `samples` holds one buffer per
+    /// `tile_size`, as `crate::render::tiles` makes them), and splats: `samples` holds one buffer per
     /// tile per pass, pass-major (`samples[p * tiles.len() + k]` belongs to
     /// `tiles[k]` in the `p`-th pass); `splats` holds lists of splats, each ordered
     /// by band (`y / tile_size`). Each band of tile rows is added in
@@ -528,21 +519,7 @@ fn add_sample<S: FilmSample>(sum: &mut [i128; 3], spectral: Option<&mut [i128; N
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn tiles_cover_any_size_exactly_once() {
-        for (w, h) in [(1, 1), (17, 5), (64, 64), (65, 33)] {
-            let mut seen = vec![0; (w * h) as usize];
-            for t in tiles(w, h, 16) {
-                for y in t.y0..t.y1 {
-                    for x in t.x0..t.x1 {
-                        seen[(y * w + x) as usize] += 1;
-                    }
-                }
-            }
-            assert!(seen.iter().all(|&c| c == 1), "{w}x{h}");
-        }
-    }
+    use crate::render::tiles;
 
     #[test]
     fn non_finite_samples_are_dropped_and_counted() {

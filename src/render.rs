@@ -33,7 +33,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use crate::color::{Spectrum, Xyz};
-use crate::film::{Film, FilmSample, Splat, Tile, tiles};
+use crate::film::{Film, FilmSample, Splat, Tile};
 use crate::integrator::{Estimator, EstimatorFn, with_estimator};
 use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
@@ -41,6 +41,17 @@ use crate::spectral::Contribution;
 
 /// Tile edge in pixels.
 pub const TILE_SIZE: u32 = 16;
+
+/// Splits a `width × height` image into tiles of at most `size × size`, row-major.
+pub(crate) fn tiles(width: u32, height: u32, size: u32) -> Vec<Tile> {
+    let mut out = Vec::new();
+    for y0 in (0..height).step_by(size as usize) {
+        for x0 in (0..width).step_by(size as usize) {
+            out.push(Tile { x0, y0, x1: (x0 + size).min(width), y1: (y0 + size).min(height) });
+        }
+    }
+    out
+}
 
 /// A batch of passes holds at least this many (pass, tile) tasks when the
 /// passes allow: the idle tail at a batch's end is then about half a task in
@@ -263,6 +274,21 @@ fn by_band<S: Copy>(splats: Vec<Splat<S>>, band_rows: u32) -> Vec<Splat<S>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tiles_cover_any_size_exactly_once() {
+        for (w, h) in [(1, 1), (17, 5), (64, 64), (65, 33)] {
+            let mut seen = vec![0; (w * h) as usize];
+            for t in tiles(w, h, 16) {
+                for y in t.y0..t.y1 {
+                    for x in t.x0..t.x1 {
+                        seen[(y * w + x) as usize] += 1;
+                    }
+                }
+            }
+            assert!(seen.iter().all(|&c| c == 1), "{w}x{h}");
+        }
+    }
 
     /// The counting sort keeps every splat once (a permutation: the same multiset of values)
     /// and orders them by band, keeping the order within a band.

@@ -10,9 +10,11 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::files::NAME_MAX;
 use super::hash::fnv1a;
 use crate::error::{Error, Result};
+
+/// The longest file name (in bytes) on Linux and most Unix file systems.
+pub const NAME_MAX: usize = 255;
 
 /// `dir/.name.tmp-PID`: a temporary name in the same directory (so the
 /// rename is atomic). When that would exceed the file system's name limit

@@ -18,11 +18,8 @@ use std::ffi::OsStr;
 use std::fs::OpenOptions;
 use std::path::{Path, PathBuf};
 
-use super::atomic_file::temp_path;
+use super::atomic_file::{NAME_MAX, temp_path};
 use crate::error::{Error, Result};
-
-/// The longest file name (in bytes) on Linux and most Unix file systems.
-pub const NAME_MAX: usize = 255;
 
 /// Reads a whole input file, refusing anything but a regular file (checked
 /// with `stat` first, so a FIFO never blocks the read).
