@@ -186,3 +186,42 @@ fn bad_light_fields_are_errors_naming_the_field() {
     let e = load_scene_str(&text, std::path::Path::new("l.ron"), &SettingsPatch::default()).unwrap_err().to_string();
     assert!(e.contains("objects[1].emission") && e.contains("cannot emit"), "{e}");
 }
+
+/// A point or spot light just inside a closed box (a solid cuboid) lights
+/// nothing outside it: the floor around the box and the box's outside must be
+/// exactly 0 with every method, for the light 1e-3, 1e-4 and 1e-6 (relative to
+/// a box of size 1 at distance about 0.5 from the floor) from the wall. Before shadow rays to a
+/// free point ran the whole distance, they stopped 1e-4 relative short of the
+/// light and missed a wall closer than that: at 1e-4 the floor lit up (max
+/// pixel 0.06). Exact, so the tolerance is 0.
+#[test]
+fn a_light_just_inside_a_closed_box_lights_nothing_outside() {
+    // The box floats above the floor with the light just above its bottom face,
+    // so the floor under it would be lit through that face.
+    let camera = "(eye: (0, 0.6, 3), look_at: (0, 0.2, 0), up: (0, 1, 0), fov_deg: 60)";
+    for gap in [1e-3f32, 1e-4, 1e-6] {
+        let y = 0.5 + gap;
+        for light in [
+            format!("Point(position: (0.2, {y}, 0.1), intensity: Constant(50))"),
+            format!(
+                "Spot(position: (0.2, {y}, 0.1), look_at: (0.2, -1, 0.1), cone_deg: 60, falloff_deg: 10, intensity: Constant(50))"
+            ),
+        ] {
+            let text =
+                scene(camera, r#"(shape: Cuboid(min: (-0.5, 0.5, -0.5), max: (0.5, 1.5, 0.5)), material: "floor")"#)
+                    .replace("],\n)", &format!("],\n    lights: [ {light} ],\n)"));
+            for integrator in [
+                IntegratorKind::Path,
+                IntegratorKind::Whitted,
+                IntegratorKind::Bdpt,
+                IntegratorKind::LightTrace,
+                IntegratorKind::Auto,
+            ] {
+                let s = SettingsPatch { max_bounces: Some(4), ..settings(integrator, 8) };
+                let film = render_str(&text, &s);
+                let max = film.mean_xyz().iter().flatten().fold(0.0f64, |m, &v| m.max(v.abs()));
+                assert_eq!(max, 0.0, "gap {gap}, {light}, {integrator:?}: light leaked (max {max})");
+            }
+        }
+    }
+}

@@ -102,18 +102,27 @@ impl Ray {
     }
 
     /// A shadow ray from surface point `p` (normal `n`) towards point `target`; returns
-    /// the ray and the `t_max` to use so that the target's own surface is not hit: the
-    /// distance shortened by `SHADOW_EPSILON` relative and by the target's own
-    /// coordinate error bound. Coincident points give `t_max = 0`.
+    /// the ray and the `t_max` to use.
+    ///
+    /// - A target on a surface (`target_n` non-zero: an area light's point, a BDPT
+    ///   vertex) must not hit its own surface: the distance is shortened by
+    ///   `SHADOW_EPSILON` relative and by the target's own coordinate error bound.
+    /// - A target that is a free point (`target_n` zero: a point or spot light, the
+    ///   eye) has no surface to miss, so the ray runs the whole distance: any surface
+    ///   before it blocks, however close to it (a point light 1e-6 inside a closed box
+    ///   lights nothing outside; shortening by 1e-4 relative let it leak).
+    ///
+    /// Coincident points give `t_max = 0`.
     #[inline(always)]
-    pub fn spawn_to(p: Vec3, n: Vec3, target: Vec3) -> (Ray, f32) {
+    pub fn spawn_to(p: Vec3, n: Vec3, target: Vec3, target_n: Vec3) -> (Ray, f32) {
         let origin = offset_ray_origin(p, n, target - p);
         let d = target - origin;
         let dist = d.length();
         if !(dist > 0.0) || !dist.is_finite() {
             return (Ray { origin, dir: n }, 0.0);
         }
-        let t_max = dist * (1.0 - SHADOW_EPSILON) - 2.0 * point_error(target);
+        let t_max =
+            if target_n == Vec3::ZERO { dist } else { dist * (1.0 - SHADOW_EPSILON) - 2.0 * point_error(target) };
         (Ray { origin, dir: d / dist }, t_max.max(0.0))
     }
 }
@@ -140,10 +149,13 @@ mod tests {
 
     #[test]
     fn spawn_to_stops_short() {
-        let (r, t) = Ray::spawn_to(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 3.0, 4.0));
+        let (r, t) = Ray::spawn_to(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 3.0, 4.0), Vec3::Z);
         assert!((r.dir.length() - 1.0).abs() < 1e-6);
         assert!(t < 5.0 && t > 4.99);
-        let (_, t0) = Ray::spawn_to(Vec3::ONE, Vec3::Y, Vec3::ONE);
+        // A free point (a point light) is reached: the ray runs the whole distance.
+        let (r, t) = Ray::spawn_to(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 3.0, 4.0), Vec3::ZERO);
+        assert!((r.at(t) - Vec3::new(0.0, 3.0, 4.0)).length() < 1e-6, "{t}");
+        let (_, t0) = Ray::spawn_to(Vec3::ONE, Vec3::Y, Vec3::ONE, Vec3::ZERO);
         assert!((0.0..1e-4).contains(&t0));
         assert_eq!(Ray::new(Vec3::ZERO, Vec3::X).at(2.0), Vec3::new(2.0, 0.0, 0.0));
     }

@@ -359,7 +359,7 @@ pub(crate) fn sample_direct<const N: usize>(
         return zero;
     }
     let side = scene.has_volumes().then(|| at.volumes_towards(volumes, ls.wi.dot(sh.n) * sh.wo_n > 0.0));
-    let Some(transmittance) = scene.transmittance(sh.p, sh.n, side.as_ref(), ls.point, lambdas) else {
+    let Some(transmittance) = scene.transmittance(sh.p, sh.n, side.as_ref(), ls.point, ls.n, lambdas) else {
         return zero;
     };
     if let Some(tr) = transmittance {

@@ -7,7 +7,7 @@
 //!
 //! | question | query |
 //! |---|---|
-//! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: hit, uv, normals, object) |
+//! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: point, normals, primitive, object) |
 //! | the BSDF at a surface | [`Scene::bsdf`] |
 //! | emission leaving a surface hit | [`Scene::le`], and its light-sampling density for MIS, [`Scene::pdf_li`] |
 //! | a point on a light towards a shading point | [`Scene::sample_li`] |
@@ -146,7 +146,10 @@ impl Scene {
     /// The one visibility rule, for shadow rays and connections of every
     /// integrator: whether the segment from surface point `p` (geometric
     /// normal `n`) to `to` is clear, and its transmittance at the packet's
-    /// wavelengths. `volumes` are the volumes around `p` on the segment's
+    /// wavelengths. `to_n` is the normal of the surface `to` lies on, or zero
+    /// when `to` is a free point (a point or spot light, the eye): then every
+    /// surface up to `to` blocks, however close (see [`Ray::spawn_to`]).
+    /// `volumes` are the volumes around `p` on the segment's
     /// side (`None` in a scene without dielectrics).
     ///
     /// Where dielectric volumes nest, the segment passes false
@@ -164,9 +167,10 @@ impl Scene {
         n: Vec3,
         volumes: Option<&VolumeStack>,
         to: Vec3,
+        to_n: Vec3,
         lambdas: &Lambdas<N>,
     ) -> Option<Option<Sampled<N>>> {
-        let (mut ray, mut t_max) = Ray::spawn_to(p, n, to);
+        let (mut ray, mut t_max) = Ray::spawn_to(p, n, to, to_n);
         match volumes {
             Some(stack) if self.nested => {
                 let mut stack = *stack;
@@ -177,7 +181,7 @@ impl Scene {
                         Some(v) if passes < MAX_PASSES && stack.crossing(v, entering) == Crossing::Pass => {
                             stack.cross(v, entering);
                             passes += 1;
-                            (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to);
+                            (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to, to_n);
                         }
                         _ => return None,
                     }

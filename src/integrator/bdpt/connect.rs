@@ -79,7 +79,7 @@ impl Bdpt {
         if is_black(&c) {
             return None;
         }
-        let transmittance = segment(scene, qs, light.media_towards(scene, s - 1, w).as_ref(), eye)?;
+        let transmittance = segment(scene, qs, light.media_towards(scene, s - 1, w).as_ref(), eye, Vec3::ZERO)?;
         let weight = if self.light_only {
             1.0
         } else {
@@ -171,7 +171,7 @@ impl Bdpt {
                     return NONE;
                 }
                 let media = camera.media_towards(scene, t - 1, ls.wi);
-                let Some(transmittance) = segment(scene, pt, media.as_ref(), ls.point) else {
+                let Some(transmittance) = segment(scene, pt, media.as_ref(), ls.point, ls.n) else {
                     return NONE;
                 };
                 // The sampled light vertex, for the MIS weight.
@@ -220,7 +220,7 @@ impl Bdpt {
                     return NONE;
                 }
                 let media = camera.media_towards(scene, t - 1, w);
-                let Some(transmittance) = segment(scene, pt, media.as_ref(), qs.p()) else {
+                let Some(transmittance) = segment(scene, pt, media.as_ref(), qs.p(), qs.sh.n) else {
                     return NONE;
                 };
                 // The four densities the connection changes, from the local
@@ -259,12 +259,19 @@ pub(super) fn scale(c: Contrib, weight: f32, transmittance: Option<Spectrum>, wl
     }
 }
 
-/// The segment of a connection from vertex `v` to point `to`, starting in the
+/// The segment of a connection from vertex `v` to point `to` (normal `to_n`,
+/// zero for a free point: the eye, a point or spot light), starting in the
 /// volumes `volumes` (those around `v` on the segment's side; `None` in a
 /// scene without dielectrics): [`Scene::transmittance`] over the full spectrum.
 /// `None` when something blocks it; else the transmittance when the segment
 /// runs in a medium.
 #[inline]
-pub(super) fn segment(scene: &Scene, v: &Vertex, volumes: Option<&VolumeStack>, to: Vec3) -> Option<Option<Spectrum>> {
-    scene.transmittance(v.p(), v.sh.n, volumes, to, &Lambdas::full())
+pub(super) fn segment(
+    scene: &Scene,
+    v: &Vertex,
+    volumes: Option<&VolumeStack>,
+    to: Vec3,
+    to_n: Vec3,
+) -> Option<Option<Spectrum>> {
+    scene.transmittance(v.p(), v.sh.n, volumes, to, to_n, &Lambdas::full())
 }
