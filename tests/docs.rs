@@ -30,7 +30,8 @@
 //! point to an existing file, and a `#anchor` into a Markdown file to one of its headings
 //! (GitHub's heading slugs).
 //!
-//! **The README** stays at most 300 lines and shows the two commands verbatim.
+//! **The README** stays at most 300 lines, shows the two commands verbatim, and its one
+//! scene example is the first block of `docs/scene-format.md`.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -400,4 +401,12 @@ fn readme_is_short_and_shows_the_two_commands() {
     let two = "```sh\ncargo run --release -- render scenes/cornell.ron -o cornell.png   # render the thesis's Cornell box\n\
                cargo test --locked                                               # the test suite (what CI runs)\n```";
     assert!(readme.contains(two), "README.md lost its two-commands block:\n{two}");
+    // The README's one scene example (loaded by tests/scenes.rs) is scene-format.md's first.
+    let readme_ron = ron_blocks(&readme);
+    let page_ron = ron_blocks(&read(&scene_format_path()));
+    assert_eq!(readme_ron.len(), 1, "README.md should hold exactly one ```ron block");
+    assert_eq!(
+        readme_ron[0].text, page_ron[0].text,
+        "README.md's scene example differs from docs/scene-format.md's first"
+    );
 }
