@@ -9,6 +9,7 @@ mod auto;
 mod bdpt;
 mod checkpoint;
 mod cli;
+mod docs;
 mod furnace;
 mod fuzz;
 mod hostile;
