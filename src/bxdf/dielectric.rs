@@ -21,10 +21,10 @@
 //! travelling a distance `d` inside keeps `exp(−σ d)` (Beer-Lambert). The
 //! integrators apply it to every path segment and shadow ray that runs inside
 //! this object's volume while it is the path's current medium
-//! ([`super::medium`]), whatever the segment ends on.
+//! ([`crate::medium::nested`]), whatever the segment ends on.
 //!
 //! **Outside medium**: the outside is vacuum unless the path is inside an
-//! enclosing dielectric ([`super::medium`]): then every method that takes a
+//! enclosing dielectric ([`crate::medium::nested`]): then every method that takes a
 //! relative index `eta` is called with `n_inside / n_outside` (per
 //! wavelength for one wavelength, at 589.3 nm for a larger packet), and
 //! those that compute it take the [`Outside`] medium.
@@ -57,7 +57,7 @@ use crate::spectral::{Lambdas, REFERENCE_LAMBDA_NM};
 
 /// The medium on the outside of a dielectric's surface: vacuum (index 1),
 /// or the inside of another dielectric that encloses the path there
-/// (nested dielectrics, [`super::medium`]).
+/// (nested dielectrics, [`crate::medium::nested`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Outside<'a>(Option<&'a Dielectric>);
 

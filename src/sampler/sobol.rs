@@ -49,7 +49,7 @@
 //! Each draw costs one 64-bit hash, and per coordinate two or three bit reversals and a
 //! four-multiply scramble (no loops, no tables). The first measurement used a loop over
 //! the index bits for dimension 1 and full bit reversals at every step; on a 64×64
-//! Cornell box it took 1.7x the independent sampler's time per sample (see the README's
+//! Cornell box it took 1.7x the independent sampler's time per sample (see docs/integrators.md,
 //! *Samplers*), which is what this form is for.
 
 /// One line of Joe and Kuo's table: degree `s`, coefficients `a`, initial `m_1 … m_s`.

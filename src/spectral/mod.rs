@@ -83,7 +83,7 @@
 //! own value at λ. So the continuous and the full-spectrum estimates of the
 //! same light differ only in interpolating a product of spectra or
 //! multiplying interpolated spectra, which is second order in the 10 nm bin
-//! spacing (a fraction of a percent in saturated colours; the README's colour
+//! spacing (a fraction of a percent in saturated colours; docs/integrators.md's colour
 //! section measures it on the Cornell box).
 //!
 //! *Spectral output* (`--spectral`) keeps the bin centres and the discrete
