@@ -8,6 +8,7 @@
 //! | question | query |
 //! |---|---|
 //! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: point, normals, primitive, object) |
+//! | the surface coordinates of a hit, for a texture lookup | [`Scene::uv`] (on demand: nothing computes them during traversal) |
 //! | the BSDF at a surface | [`Scene::bsdf`] |
 //! | emission leaving a surface hit | [`Scene::le`], and its light-sampling density for MIS, [`Scene::pdf_li`] |
 //! | a point on a light towards a shading point | [`Scene::sample_li`] |
@@ -58,6 +59,13 @@ pub struct LightChoice {
 }
 
 impl Scene {
+    /// The (u, v) coordinates of a hit on its object's surface (each shape's
+    /// parameterisation is in `shape/uv.rs`).
+    #[inline]
+    pub fn uv(&self, si: &SurfaceHit) -> glam::Vec2 {
+        self.objects[si.object as usize].shape.uv(&si.hit)
+    }
+
     /// The BSDF of object `object`'s material.
     #[inline]
     pub fn bsdf(&self, object: u32) -> &Bxdf {

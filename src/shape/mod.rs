@@ -21,6 +21,7 @@ mod plane;
 mod quad;
 mod sphere;
 mod triangle;
+mod uv;
 
 pub use batch::Batch;
 pub use bubble::Bubble;
