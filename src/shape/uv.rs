@@ -22,7 +22,7 @@ use std::f32::consts::TAU;
 
 use glam::{Vec2, Vec3};
 
-use super::{Cuboid, Disk, Mesh, Plane, Quad, Shape, Sphere};
+use super::{Cuboid, Disk, Mesh, Plane, Quad, Shape};
 use crate::geometry::{Frame, Hit};
 
 impl Shape {
@@ -108,6 +108,7 @@ fn mesh_uv(m: &Mesh, prim: u32, p: Vec3) -> Vec2 {
 mod tests {
     use super::*;
     use crate::geometry::Ray;
+    use crate::shape::Sphere;
 
     /// The hit of a ray from `from` towards `to` on `shape`.
     fn hit(shape: &Shape, from: Vec3, to: Vec3) -> Hit {
