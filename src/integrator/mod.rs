@@ -359,12 +359,10 @@ pub(crate) fn sample_direct<const N: usize>(
         return zero;
     }
     let side = scene.has_volumes().then(|| at.volumes_towards(volumes, ls.wi.dot(sh.n) * sh.wo_n > 0.0));
-    let Some(transmittance) = scene.transmittance(sh.p, sh.n, side.as_ref(), ls.point, ls.n, lambdas) else {
+    let Some(clear) = scene.transmittance(sh.p, sh.n, side.as_ref(), ls.point, ls.n) else {
         return zero;
     };
-    if let Some(tr) = transmittance {
-        f *= tr;
-    }
+    clear.attenuate(&mut f, lambdas);
     let pdf_light = choice.pmf * ls.pdf;
     let weight = if ls.is_delta || !mis {
         1.0

@@ -13,7 +13,7 @@ mod query;
 mod spectra;
 
 pub use load::{load_scene, load_scene_str};
-pub use query::{Emitted, LightChoice, MAX_PASSES};
+pub use query::{Clear, Emitted, LightChoice, MAX_PASSES};
 
 use crate::bxdf::Bxdf;
 use crate::camera::Camera;

@@ -273,5 +273,5 @@ pub(super) fn segment(
     to: Vec3,
     to_n: Vec3,
 ) -> Option<Option<Spectrum>> {
-    scene.transmittance(v.p(), v.sh.n, volumes, to, to_n, &Lambdas::full())
+    scene.transmittance(v.p(), v.sh.n, volumes, to, to_n).map(|clear| clear.spectrum())
 }
