@@ -3,7 +3,10 @@
 //! from the centre, the inner surface's normal towards it (out of the shell, into the cavity).
 
 use super::sphere::{first_root, reproject, sphere_roots};
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A spherical shell of radii `inner_radius < outer_radius` around `center`.
@@ -51,6 +54,27 @@ impl Bubble {
     pub fn bounds(&self) -> Aabb {
         let r = Vec3::splat(self.outer_radius.abs());
         Aabb::new(self.center - r, self.center + r)
+    }
+}
+
+impl Bubble {
+    /// A bubble from the scene description at `field`: the inner radius must be the smaller.
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        center: V3,
+        outer_radius: f32,
+        inner_radius: f32,
+    ) -> Result<Bubble> {
+        let f = |name: &str| format!("{field}.{name}");
+        let outer = check.positive(&f("outer_radius"), outer_radius)?;
+        let inner = check.positive(&f("inner_radius"), inner_radius)?;
+        if inner >= outer {
+            return Err(
+                check.err(f("inner_radius"), format!("expected less than outer_radius ({outer}), found {inner}"))
+            );
+        }
+        Ok(Bubble { center: check.vec(&f("center"), center)?, outer_radius: outer, inner_radius: inner })
     }
 }
 

@@ -1,7 +1,10 @@
 //! Cuboids: axis-aligned boxes as solids (normals point outward). A ray starting
 //! inside hits the far face, still with the outward normal.
 
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A solid axis-aligned box `[min, max]`.
@@ -83,6 +86,17 @@ impl Cuboid {
     /// Bounding box (the box itself).
     pub fn bounds(&self) -> Aabb {
         Aabb { min: self.min, max: self.max }
+    }
+}
+
+impl Cuboid {
+    /// A cuboid from the scene description at `field`: `min < max` on every axis.
+    pub(crate) fn from_desc(check: &Check, field: &str, min: V3, max: V3) -> Result<Cuboid> {
+        let (lo, hi) = (check.vec(&format!("{field}.min"), min)?, check.vec(&format!("{field}.max"), max)?);
+        if !lo.cmplt(hi).all() {
+            return Err(check.err(field, "expected min < max on every axis"));
+        }
+        Ok(Cuboid { min: lo, max: hi })
     }
 }
 

@@ -1,7 +1,10 @@
 //! Disks: flat circles, one-sided normal given by the user (the same on both sides).
 
 use super::plane::{plane_t, project};
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A disk of radius `radius` around `center` in the plane with unit normal `normal`.
@@ -47,6 +50,17 @@ impl Disk {
         let n = self.normal;
         let e = (Vec3::ONE - n * n).max(Vec3::ZERO).powf(0.5) * self.radius.abs();
         Aabb::new(self.center - e, self.center + e)
+    }
+}
+
+impl Disk {
+    /// A disk from the scene description at `field` (the normal need not be unit).
+    pub(crate) fn from_desc(check: &Check, field: &str, center: V3, normal: V3, radius: f32) -> Result<Disk> {
+        Ok(Disk {
+            center: check.vec(&format!("{field}.center"), center)?,
+            normal: check.direction(&format!("{field}.normal"), normal)?,
+            radius: check.positive(&format!("{field}.radius"), radius)?,
+        })
     }
 }
 

@@ -3,6 +3,9 @@
 //! mesh's own [`WideBvh`], which also stores the triangles (four to a block, in leaf
 //! order); `Hit::prim` is a triangle's index in that order (its slot).
 
+use crate::io::parse_mesh;
+use crate::scene::check::Check;
+use crate::scene::desc::{ScaleDesc, V3};
 use std::path::Path;
 
 use glam::{Mat3, Vec3};
@@ -251,6 +254,28 @@ impl Mesh {
     /// True if the mesh has per-vertex normals.
     pub fn has_normals(&self) -> bool {
         self.normals.is_some()
+    }
+}
+
+impl Mesh {
+    /// A mesh from the scene description at `field`: the file `path` (relative to the
+    /// scene file, recorded in the scene's identity), placed by its own transform.
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        path: &str,
+        scale: &Option<ScaleDesc>,
+        rotate_deg: &Option<V3>,
+        translate: &Option<V3>,
+    ) -> Result<Mesh> {
+        let f = |name: &str| format!("{field}.{name}");
+        let transform = check.transform(field, scale, rotate_deg, translate)?;
+        let (file, bytes) = check.read_input(&f("path"), path)?;
+        let data = parse_mesh(bytes, &file).map_err(|e| check.err(f("path"), e.to_string()))?;
+        Mesh::from_data(data, &file, &transform).map_err(|e| match e {
+            Error::Setting { name, message } => check.err(f(name), message),
+            e => check.err(f("path"), e.to_string()),
+        })
     }
 }
 

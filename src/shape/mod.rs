@@ -33,7 +33,10 @@ pub use quad::Quad;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::ShapeDesc;
 
 /// Any shape of the renderer.
 #[derive(Clone, Debug)]
@@ -94,6 +97,30 @@ impl Shape {
             Shape::Quad(s) => Some(s.bounds()),
             Shape::Mesh(s) => Some(s.bounds()),
         }
+    }
+}
+
+impl Shape {
+    /// The shape of a scene description at `field` (`objects[i].shape`), each built
+    /// and checked by its own type's `from_desc`.
+    pub(crate) fn from_desc(check: &Check, field: &str, d: &ShapeDesc) -> Result<Shape> {
+        Ok(match d {
+            ShapeDesc::Sphere { center, radius } => Shape::Sphere(Sphere::from_desc(check, field, *center, *radius)?),
+            ShapeDesc::Bubble { center, outer_radius, inner_radius } => {
+                Shape::Bubble(Bubble::from_desc(check, field, *center, *outer_radius, *inner_radius)?)
+            }
+            ShapeDesc::Plane { point, normal } => Shape::Plane(Plane::from_desc(check, field, *point, *normal)?),
+            ShapeDesc::Disk { center, normal, radius } => {
+                Shape::Disk(Disk::from_desc(check, field, *center, *normal, *radius)?)
+            }
+            ShapeDesc::Cuboid { min, max } => Shape::Cuboid(Cuboid::from_desc(check, field, *min, *max)?),
+            ShapeDesc::Quad { origin, edge_u, edge_v } => {
+                Shape::Quad(Quad::from_desc(check, field, *origin, *edge_u, *edge_v)?)
+            }
+            ShapeDesc::Mesh { path, scale, rotate_deg, translate } => {
+                Shape::Mesh(Box::new(Mesh::from_desc(check, field, path, scale, rotate_deg, translate)?))
+            }
+        })
     }
 }
 

@@ -1,6 +1,9 @@
 //! Infinite planes (unbounded, so they live outside the scene BVH).
 
+use crate::error::Result;
 use crate::geometry::{Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// The infinite plane through `point` with unit normal `normal` (the same normal on both sides).
@@ -49,6 +52,16 @@ impl Plane {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         plane_t(self.normal, self.normal.dot(self.point), ray, t_max).is_some()
+    }
+}
+
+impl Plane {
+    /// A plane from the scene description at `field` (the normal need not be unit).
+    pub(crate) fn from_desc(check: &Check, field: &str, point: V3, normal: V3) -> Result<Plane> {
+        Ok(Plane {
+            point: check.vec(&format!("{field}.point"), point)?,
+            normal: check.direction(&format!("{field}.normal"), normal)?,
+        })
     }
 }
 

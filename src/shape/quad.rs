@@ -2,7 +2,10 @@
 //! normal `normalize(edge_u x edge_v)` (the same on both sides). Typical area lights.
 
 use super::plane::plane_t;
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A parallelogram, with the plane and the coordinate projection precomputed
@@ -96,6 +99,17 @@ impl Quad {
         Aabb::new(self.origin, self.origin + self.edge_u)
             .grow(self.origin + self.edge_v)
             .grow(self.origin + self.edge_u + self.edge_v)
+    }
+}
+
+impl Quad {
+    /// A quad from the scene description at `field`: the edges must span a parallelogram.
+    pub(crate) fn from_desc(check: &Check, field: &str, origin: V3, edge_u: V3, edge_v: V3) -> Result<Quad> {
+        let (u, v) = (check.vec(&format!("{field}.edge_u"), edge_u)?, check.vec(&format!("{field}.edge_v"), edge_v)?);
+        if u.cross(v).length_squared() <= f32::MIN_POSITIVE {
+            return Err(check.err(field, "edge_u and edge_v must be non-zero and not parallel"));
+        }
+        Ok(Quad::new(check.vec(&format!("{field}.origin"), origin)?, u, v))
     }
 }
 
