@@ -18,7 +18,7 @@ use crate::io::{Fnv1a, fnv1a, read_input};
 use crate::light::Light;
 use crate::material;
 use crate::settings::{Settings, SettingsPatch};
-use crate::shape::Shape;
+use crate::shape::{Placement, Shape};
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
 /// precedence over the file's `render` settings. The file must be a regular
@@ -138,7 +138,14 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     let mut lights = Vec::new();
     for (i, o) in desc.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
-        let shape = Shape::from_desc(ctx, &format!("{field}.shape"), &o.shape)?;
+        let xf = match &o.transform {
+            None => None,
+            Some(t) => {
+                let tf = format!("{field}.transform");
+                Some(Placement { t: ctx.transform(&tf, &t.scale, &t.rotate_deg, &t.translate)?, field: tf })
+            }
+        };
+        let shape = Shape::from_desc(ctx, &format!("{field}.shape"), &o.shape, xf.as_ref())?;
         let material = match &o.material {
             Some(name) => *by_name.get(name.as_str()).ok_or_else(|| {
                 let known: Vec<&str> = by_name.keys().copied().collect();

@@ -2,6 +2,7 @@
 //! concentric inner sphere (the cavity). The outer surface's normal points away
 //! from the centre, the inner surface's normal towards it (out of the shell, into the cavity).
 
+use super::Placement;
 use super::sphere::{first_root, reproject, sphere_roots};
 use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
@@ -58,13 +59,15 @@ impl Bubble {
 }
 
 impl Bubble {
-    /// A bubble from the scene description at `field`: the inner radius must be the smaller.
+    /// A bubble from the scene description at `field`: the inner radius must be the
+    /// smaller; placed by `xf` (uniform scale only).
     pub(crate) fn from_desc(
         check: &Check,
         field: &str,
         center: V3,
         outer_radius: f32,
         inner_radius: f32,
+        xf: Option<&Placement>,
     ) -> Result<Bubble> {
         let f = |name: &str| format!("{field}.{name}");
         let outer = check.positive(&f("outer_radius"), outer_radius)?;
@@ -74,7 +77,18 @@ impl Bubble {
                 check.err(f("inner_radius"), format!("expected less than outer_radius ({outer}), found {inner}"))
             );
         }
-        Ok(Bubble { center: check.vec(&f("center"), center)?, outer_radius: outer, inner_radius: inner })
+        let center = check.vec(&f("center"), center)?;
+        match xf {
+            None => Ok(Bubble { center, outer_radius: outer, inner_radius: inner }),
+            Some(x) => {
+                let s = x.uniform_scale(check, "bubble")?;
+                let (outer, inner) = (x.length(check, outer, s)?, x.length(check, inner, s)?);
+                if inner >= outer {
+                    return Err(check.err(format!("{}.scale", x.field), "the scale makes the radii equal in f32"));
+                }
+                Ok(Bubble { center: x.point(check, center)?, outer_radius: outer, inner_radius: inner })
+            }
+        }
     }
 }
 

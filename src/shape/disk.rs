@@ -1,5 +1,6 @@
 //! Disks: flat circles, one-sided normal given by the user (the same on both sides).
 
+use super::Placement;
 use super::plane::{plane_t, project};
 use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
@@ -54,13 +55,30 @@ impl Disk {
 }
 
 impl Disk {
-    /// A disk from the scene description at `field` (the normal need not be unit).
-    pub(crate) fn from_desc(check: &Check, field: &str, center: V3, normal: V3, radius: f32) -> Result<Disk> {
-        Ok(Disk {
-            center: check.vec(&format!("{field}.center"), center)?,
-            normal: check.direction(&format!("{field}.normal"), normal)?,
-            radius: check.positive(&format!("{field}.radius"), radius)?,
-        })
+    /// A disk from the scene description at `field` (the normal need not be unit),
+    /// placed by `xf` (uniform scale only: a disk scaled otherwise would be an ellipse).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        center: V3,
+        normal: V3,
+        radius: f32,
+        xf: Option<&Placement>,
+    ) -> Result<Disk> {
+        let center = check.vec(&format!("{field}.center"), center)?;
+        let normal = check.direction(&format!("{field}.normal"), normal)?;
+        let radius = check.positive(&format!("{field}.radius"), radius)?;
+        match xf {
+            None => Ok(Disk { center, normal, radius }),
+            Some(x) => {
+                let s = x.uniform_scale(check, "disk")?;
+                Ok(Disk {
+                    center: x.point(check, center)?,
+                    normal: x.normal(check, normal)?,
+                    radius: x.length(check, radius, s)?,
+                })
+            }
+        }
     }
 }
 

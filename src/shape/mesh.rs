@@ -3,6 +3,7 @@
 //! mesh's own [`WideBvh`], which also stores the triangles (four to a block, in leaf
 //! order); `Hit::prim` is a triangle's index in that order (its slot).
 
+use super::Placement;
 use crate::io::parse_mesh;
 use crate::scene::check::Check;
 use crate::scene::desc::{ScaleDesc, V3};
@@ -76,8 +77,18 @@ impl Mesh {
 
     /// [`Mesh::load`] from a mesh file's parsed contents (`path` names it in errors).
     pub fn from_data(data: MeshData, path: &Path, transform: &Transform) -> Result<Mesh> {
+        Mesh::from_data_placed(data, path, transform, None)
+    }
+
+    /// [`Mesh::from_data`], then placed by `then` (an object's transform) when given.
+    pub(crate) fn from_data_placed(
+        data: MeshData,
+        path: &Path,
+        transform: &Transform,
+        then: Option<&Transform>,
+    ) -> Result<Mesh> {
         let MeshData { positions, triangles, normals } = data;
-        Mesh::build(positions, triangles, normals, transform, &|m| Error::mesh(path, m))
+        Mesh::build(positions, triangles, normals, transform, then, &|m| Error::mesh(path, m))
     }
 
     /// The raw contents of a mesh file as [`Mesh::load`] reads them, before any transform
@@ -92,7 +103,9 @@ impl Mesh {
     /// A mesh from positions, triangles (indices into `positions`, counter-clockwise
     /// front) and optional per-vertex normals; errors are [`Error::Settings`].
     pub fn from_triangles(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, normals: Option<Vec<Vec3>>) -> Result<Mesh> {
-        Mesh::build(positions, indices, normals, &Transform::default(), &|m| Error::Settings(format!("mesh: {m}")))
+        Mesh::build(positions, indices, normals, &Transform::default(), None, &|m| {
+            Error::Settings(format!("mesh: {m}"))
+        })
     }
 
     fn build(
@@ -100,24 +113,32 @@ impl Mesh {
         indices: Vec<[u32; 3]>,
         mut normals: Option<Vec<Vec3>>,
         transform: &Transform,
+        then: Option<&Transform>,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
         let setting = |name, message| Error::Setting { name, message };
-        if !transform.rotate_deg.is_finite() {
-            return Err(setting("rotate_deg", format!("expected finite angles, found {}", transform.rotate_deg)));
+        for t in std::iter::once(transform).chain(then) {
+            if !t.rotate_deg.is_finite() {
+                return Err(setting("rotate_deg", format!("expected finite angles, found {}", t.rotate_deg)));
+            }
+            if !t.translate.is_finite() {
+                return Err(setting("translate", format!("expected finite coordinates, found {}", t.translate)));
+            }
         }
-        if !transform.translate.is_finite() {
-            return Err(setting("translate", format!("expected finite coordinates, found {}", transform.translate)));
-        }
-        let m = transform.linear();
+        // The mesh's own placement, then the object's (`then`): one affine map.
+        let (m, translate) = match then {
+            None => (transform.linear(), transform.translate),
+            Some(o) => {
+                let lo = o.linear();
+                (lo * transform.linear(), lo * transform.translate + o.translate)
+            }
+        };
         let det = m.determinant();
         if !(det != 0.0 && det.is_finite()) {
+            let scale = then.map_or(transform.scale, |o| o.scale * transform.scale);
             return Err(setting(
                 "scale",
-                format!(
-                    "the scale {} makes the transform singular in f32 (its determinant is {det:e})",
-                    transform.scale
-                ),
+                format!("the scale {scale} makes the transform singular in f32 (its determinant is {det:e})"),
             ));
         }
         if let Some(ns) = &normals
@@ -129,7 +150,7 @@ impl Mesh {
             if !p.is_finite() {
                 return Err(err(format!("vertex {i} has a non-finite coordinate {p}")));
             }
-            *p = m * *p + transform.translate;
+            *p = m * *p + translate;
             if !p.is_finite() {
                 return Err(setting(
                     "scale",
@@ -267,15 +288,36 @@ impl Mesh {
         scale: &Option<ScaleDesc>,
         rotate_deg: &Option<V3>,
         translate: &Option<V3>,
+        xf: Option<&Placement>,
     ) -> Result<Mesh> {
         let f = |name: &str| format!("{field}.{name}");
         let transform = check.transform(field, scale, rotate_deg, translate)?;
         let (file, bytes) = check.read_input(&f("path"), path)?;
         let data = parse_mesh(bytes, &file).map_err(|e| check.err(f("path"), e.to_string()))?;
-        Mesh::from_data(data, &file, &transform).map_err(|e| match e {
-            Error::Setting { name, message } => check.err(f(name), message),
-            e => check.err(f("path"), e.to_string()),
+        Mesh::from_data_placed(data, &file, &transform, xf.map(|x| &x.t)).map_err(|e| match (e, xf) {
+            // A transform that breaks the composed placement is the object's when it has one.
+            (Error::Setting { name, message }, Some(x)) => check.err(format!("{}.{name}", x.field), message),
+            (Error::Setting { name, message }, None) => check.err(f(name), message),
+            (e, _) => check.err(f("path"), e.to_string()),
         })
+    }
+
+    /// A cuboid `[min, max]` placed by `t` as a closed mesh of 12 triangles, wound
+    /// counter-clockwise seen from outside (outward normals: still a solid).
+    pub(crate) fn cuboid(min: Vec3, max: Vec3, t: &Transform) -> Result<Mesh> {
+        let corners: Vec<Vec3> =
+            (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), max, min)).collect();
+        // Corner i has x = bit 0, y = bit 1, z = bit 2; two triangles per face.
+        let faces: [[u32; 4]; 6] = [
+            [0, 4, 6, 2], // -x
+            [1, 3, 7, 5], // +x
+            [0, 1, 5, 4], // -y
+            [2, 6, 7, 3], // +y
+            [0, 2, 3, 1], // -z
+            [4, 5, 7, 6], // +z
+        ];
+        let tris = faces.iter().flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]]).collect();
+        Mesh::build(corners, tris, None, &Transform::default(), Some(t), &|m| Error::Settings(format!("cuboid: {m}")))
     }
 }
 
@@ -489,18 +531,18 @@ mod tests {
         let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
         let t =
             Transform { scale: Vec3::new(2.0, 3.0, 1.0), rotate_deg: Vec3::new(0.0, 0.0, 90.0), translate: Vec3::Z };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &t, &|m| Error::Settings(m)).unwrap();
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &t, None, &|m| Error::Settings(m)).unwrap();
         let [a, b, c] = m.triangle(0);
         assert!((a - Vec3::Z).length() < 1e-6);
         assert!((b - Vec3::new(0.0, 2.0, 1.0)).length() < 1e-6, "{b}");
         assert!((c - Vec3::new(-3.0, 0.0, 1.0)).length() < 1e-6, "{c}");
         // Mirroring keeps the front side (normal +z before and after).
         let mirror = Transform { scale: Vec3::new(-1.0, 1.0, 1.0), ..Default::default() };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &mirror, &|m| Error::Settings(m)).unwrap();
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &mirror, None, &|m| Error::Settings(m)).unwrap();
         let h = m.intersect(&Ray::new(Vec3::new(-0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
         assert_eq!(h.n, Vec3::Z);
         assert!(
-            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &Transform { scale: Vec3::ZERO, ..t }, &|m| {
+            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &Transform { scale: Vec3::ZERO, ..t }, None, &|m| {
                 Error::Settings(m)
             })
             .is_err()

@@ -1,5 +1,6 @@
 //! Infinite planes (unbounded, so they live outside the scene BVH).
 
+use super::Placement;
 use crate::error::Result;
 use crate::geometry::{Hit, Ray};
 use crate::scene::check::Check;
@@ -56,12 +57,21 @@ impl Plane {
 }
 
 impl Plane {
-    /// A plane from the scene description at `field` (the normal need not be unit).
-    pub(crate) fn from_desc(check: &Check, field: &str, point: V3, normal: V3) -> Result<Plane> {
-        Ok(Plane {
-            point: check.vec(&format!("{field}.point"), point)?,
-            normal: check.direction(&format!("{field}.normal"), normal)?,
-        })
+    /// A plane from the scene description at `field` (the normal need not be unit),
+    /// placed by `xf` (any scale).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        point: V3,
+        normal: V3,
+        xf: Option<&Placement>,
+    ) -> Result<Plane> {
+        let point = check.vec(&format!("{field}.point"), point)?;
+        let normal = check.direction(&format!("{field}.normal"), normal)?;
+        match xf {
+            None => Ok(Plane { point, normal }),
+            Some(x) => Ok(Plane { point: x.point(check, point)?, normal: x.normal(check, normal)? }),
+        }
     }
 }
 

@@ -1,6 +1,7 @@
 //! Spheres, intersected with the numerically stable quadratic and hit points
 //! re-projected onto the surface (so spawned rays do not re-hit it).
 
+use super::Placement;
 use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
 use crate::scene::check::Check;
@@ -112,12 +113,24 @@ impl Sphere {
 }
 
 impl Sphere {
-    /// A sphere from the scene description at `field` (`objects[i].shape`).
-    pub(crate) fn from_desc(check: &Check, field: &str, center: V3, radius: f32) -> Result<Sphere> {
-        Ok(Sphere::new(
-            check.vec(&format!("{field}.center"), center)?,
-            check.positive(&format!("{field}.radius"), radius)?,
-        ))
+    /// A sphere from the scene description at `field` (`objects[i].shape`), placed by
+    /// `xf` (uniform scale only).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        center: V3,
+        radius: f32,
+        xf: Option<&Placement>,
+    ) -> Result<Sphere> {
+        let center = check.vec(&format!("{field}.center"), center)?;
+        let radius = check.positive(&format!("{field}.radius"), radius)?;
+        match xf {
+            None => Ok(Sphere::new(center, radius)),
+            Some(x) => {
+                let s = x.uniform_scale(check, "sphere")?;
+                Ok(Sphere::new(x.point(check, center)?, x.length(check, radius, s)?))
+            }
+        }
     }
 }
 
