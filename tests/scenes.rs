@@ -9,7 +9,7 @@ use rust_v::geometry::Ray;
 use rust_v::scene::load_scene_str;
 use rust_v::shape::{Cuboid, Shape};
 
-use crate::common::{root, rust_v, temp_dir};
+use crate::common::{render_str, root, rust_v, temp_dir};
 
 fn scene_files() -> Vec<std::path::PathBuf> {
     let mut v: Vec<_> = std::fs::read_dir(root().join("scenes"))
@@ -321,4 +321,75 @@ fn bad_transforms_name_the_field() {
     );
     let e = load_scene_str(&text, Path::new("t.ron"), &Default::default()).unwrap_err().to_string();
     assert!(e.starts_with("t.ron:5:") && e.contains("`rotate`") && e.contains("`rotate_deg`"), "{e}");
+}
+
+/// A unit square at z = 0 facing +z, seen from the front and lit.
+const SQUARE_POSITIONS: &str = "positions: [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]";
+
+fn square_scene(shape: &str) -> String {
+    format!(
+        r#"(
+    camera: (eye: (0.3, 0.2, 4), look_at: (0, 0, 0), fov_deg: 40),
+    render: (width: 12, height: 12, spp: 4, seed: 3),
+    materials: {{ "white": Lambertian(reflectance: Constant(0.5)) }},
+    objects: [
+        (shape: {shape}, material: "white"),
+        (shape: Sphere(center: (0.5, 0.5, 2), radius: 0.2), emission: Constant(20)),
+    ],
+    lights: [ Point(position: (-1, 1, 2), intensity: Constant(3)) ],
+)"#
+    )
+}
+
+#[test]
+fn an_inline_mesh_renders_like_the_same_obj_file() {
+    let dir = temp_dir("inline-mesh");
+    let obj = dir.join("square.obj");
+    std::fs::write(&obj, "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
+    let from_file = render_str(&square_scene(&format!("Mesh(path: {:?})", obj.to_str().unwrap())), &Default::default());
+    let inline = render_str(
+        &square_scene(&format!("Triangles({SQUARE_POSITIONS}, indices: [(0, 1, 2), (0, 2, 3)])")),
+        &Default::default(),
+    );
+    let (a, b) = (from_file.mean_xyz(), inline.mean_xyz());
+    assert!(a.iter().filter(|p| p[1] > 0.0).count() > a.len() / 4, "the square is lit");
+    assert!(a.iter().zip(&b).all(|(p, q)| p.map(f64::to_bits) == q.map(f64::to_bits)), "bit-identical");
+    // With normals and uvs it is still a mesh, and it can emit.
+    let text = one_object(&format!(
+        "(shape: Triangles({SQUARE_POSITIONS}, indices: [(0, 1, 2), (0, 2, 3)], normals: [(0, 0, 1), (0, 0, 1), \
+         (0, 0, 1), (0, 0, 1)], uvs: [(0, 0), (1, 0), (1, 1), (0, 1)]), emission: Constant(1))"
+    ));
+    let scene = load_scene_str(&text, Path::new("t.ron"), &Default::default()).unwrap();
+    let Shape::Mesh(m) = &scene.objects[0].shape else { panic!("an inline mesh is a mesh") };
+    assert!(m.has_normals() && m.triangle_count() == 2 && scene.lights.len() == 2);
+}
+
+#[test]
+fn bad_inline_meshes_name_the_field() {
+    let p3 = "positions: [(0, 0, 0), (1, 0, 0), (0, 1, 0)]";
+    let cases = [
+        (format!("{p3}, indices: [(0, 1, 5)]"), "objects[0].shape.indices[0]", "vertex index 5 out of range"),
+        (format!("{p3}, indices: [(0, 1, 2), (2, 3, 0)]"), "objects[0].shape.indices[1]", "there are 3 positions"),
+        (format!("{p3}, indices: [(0, 1, 2)], normals: [(0, 0, 1)]"), "objects[0].shape.normals", "found 1"),
+        (
+            format!("{p3}, indices: [(0, 1, 2)], normals: [(0, 0, 1), (0, 0, 0), (0, 0, 1)]"),
+            "objects[0].shape.normals[1]",
+            "non-zero",
+        ),
+        (
+            format!("{p3}, indices: [(0, 1, 2)], uvs: [(0, 0), (1, 0)]"),
+            "objects[0].shape.uvs",
+            "one entry per position",
+        ),
+        (format!("{p3}, indices: [(0, 1, 2)], uvs: [(0, 0), (1, 0), (inf, 0)]"), "objects[0].shape.uvs[2]", "finite"),
+        ("positions: [(0, 0, 0), (1, NaN, 0)], indices: [(0, 1, 1)]".into(), "objects[0].shape.positions[1]", "finite"),
+        ("positions: [], indices: [(0, 1, 2)]".into(), "objects[0].shape.positions", "at least one"),
+        (format!("{p3}, indices: []"), "objects[0].shape.indices", "at least one triangle"),
+        (format!("{p3}, indices: [(0, 1, 1)]"), "objects[0].shape.indices", "no valid triangles"),
+    ];
+    for (body, field, message) in cases {
+        let text = one_object(&format!(r#"(shape: Triangles({body}), material: "white")"#));
+        let e = load_scene_str(&text, Path::new("t.ron"), &Default::default()).unwrap_err().to_string();
+        assert!(e.contains(&format!("t.ron: {field}: ")) && e.contains(message), "{body}: {e}");
+    }
 }

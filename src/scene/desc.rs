@@ -297,6 +297,21 @@ pub enum ShapeDesc {
         /// Second edge.
         edge_v: V3,
     },
+    /// A triangle mesh given inline, built like a mesh file's contents:
+    /// `Triangles(positions: [(0, 0, 0), (1, 0, 0), (1, 1, 0)], indices: [(0, 1, 2)])`.
+    Triangles {
+        /// Vertex positions.
+        positions: Vec<V3>,
+        /// Triangles as indices into `positions`, counter-clockwise seen from the front.
+        indices: Vec<[u32; 3]>,
+        /// Per-vertex shading normals, one per position (default: flat triangles).
+        #[serde(default)]
+        normals: Option<Vec<V3>>,
+        /// Per-vertex texture coordinates `(u, v)`, one per position (kept for textures,
+        /// issue 35; default: none).
+        #[serde(default)]
+        uvs: Option<Vec<[f32; 2]>>,
+    },
     /// A triangle mesh from an OBJ or PLY file (optionally .gz), relative to the scene file.
     Mesh {
         /// The mesh file.

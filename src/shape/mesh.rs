@@ -87,8 +87,19 @@ impl Mesh {
         transform: &Transform,
         then: Option<&Transform>,
     ) -> Result<Mesh> {
+        Mesh::from_parts(data, transform, then, &|m| Error::mesh(path, m))
+    }
+
+    /// A mesh from parsed contents (a file's or an inline description's), placed by
+    /// `transform` then `then`; `err` makes the errors about the contents.
+    pub(crate) fn from_parts(
+        data: MeshData,
+        transform: &Transform,
+        then: Option<&Transform>,
+        err: &dyn Fn(String) -> Error,
+    ) -> Result<Mesh> {
         let MeshData { positions, triangles, normals } = data;
-        Mesh::build(positions, triangles, normals, transform, then, &|m| Error::mesh(path, m))
+        Mesh::build(positions, triangles, normals, transform, then, err)
     }
 
     /// The raw contents of a mesh file as [`Mesh::load`] reads them, before any transform

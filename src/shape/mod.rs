@@ -16,6 +16,7 @@ mod bubble;
 mod bvh;
 mod cuboid;
 mod disk;
+mod inline;
 mod mesh;
 mod plane;
 mod quad;
@@ -181,6 +182,15 @@ impl Shape {
             ShapeDesc::Quad { origin, edge_u, edge_v } => {
                 Shape::Quad(Quad::from_desc(check, field, *origin, *edge_u, *edge_v, xf)?)
             }
+            ShapeDesc::Triangles { positions, indices, normals, uvs } => Shape::Mesh(Box::new(Mesh::from_inline_desc(
+                check,
+                field,
+                positions,
+                indices,
+                normals.as_deref(),
+                uvs.as_deref(),
+                xf,
+            )?)),
             ShapeDesc::Mesh { path, scale, rotate_deg, translate } => {
                 Shape::Mesh(Box::new(Mesh::from_desc(check, field, path, scale, rotate_deg, translate, xf)?))
             }
