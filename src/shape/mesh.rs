@@ -53,10 +53,13 @@ impl Transform {
 /// A triangle mesh with optional per-vertex normals and its own BVH.
 #[derive(Clone, Debug)]
 pub struct Mesh {
-    /// Vertex indices of each triangle (slot order), kept only with normals.
-    normal_idx: Vec<[u32; 3]>,
+    /// Vertex indices of each triangle (slot order), kept only with normals or uvs.
+    vert_idx: Vec<[u32; 3]>,
     /// Unit per-vertex normals, if the file had them.
     normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, if given (for textures, issue 35; no cost
+    /// for a mesh without).
+    uvs: Option<Vec<[f32; 2]>>,
     /// The BVH, which holds the vertices of each triangle in slot order.
     bvh: WideBvh,
     /// Input triangle indices of the dropped zero-area triangles, ascending.
@@ -87,19 +90,21 @@ impl Mesh {
         transform: &Transform,
         then: Option<&Transform>,
     ) -> Result<Mesh> {
-        Mesh::from_parts(data, transform, then, &|m| Error::mesh(path, m))
+        Mesh::from_parts(data, None, transform, then, &|m| Error::mesh(path, m))
     }
 
-    /// A mesh from parsed contents (a file's or an inline description's), placed by
-    /// `transform` then `then`; `err` makes the errors about the contents.
+    /// A mesh from parsed contents (a file's or an inline description's) and optional
+    /// per-vertex `uvs` (one per position: the caller checks), placed by `transform`
+    /// then `then`; `err` makes the errors about the contents.
     pub(crate) fn from_parts(
         data: MeshData,
+        uvs: Option<Vec<[f32; 2]>>,
         transform: &Transform,
         then: Option<&Transform>,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
         let MeshData { positions, triangles, normals } = data;
-        Mesh::build(positions, triangles, normals, transform, then, err)
+        Mesh::build(positions, triangles, normals, uvs, transform, then, err)
     }
 
     /// The raw contents of a mesh file as [`Mesh::load`] reads them, before any transform
@@ -114,7 +119,7 @@ impl Mesh {
     /// A mesh from positions, triangles (indices into `positions`, counter-clockwise
     /// front) and optional per-vertex normals; errors are [`Error::Settings`].
     pub fn from_triangles(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, normals: Option<Vec<Vec3>>) -> Result<Mesh> {
-        Mesh::build(positions, indices, normals, &Transform::default(), None, &|m| {
+        Mesh::build(positions, indices, normals, None, &Transform::default(), None, &|m| {
             Error::Settings(format!("mesh: {m}"))
         })
     }
@@ -123,6 +128,7 @@ impl Mesh {
         mut positions: Vec<Vec3>,
         indices: Vec<[u32; 3]>,
         mut normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<[f32; 2]>>,
         transform: &Transform,
         then: Option<&Transform>,
         err: &dyn Fn(String) -> Error,
@@ -202,8 +208,9 @@ impl Mesh {
         }
         let bvh = WideBvh::build_indexed(&positions, &kept);
         let order = bvh.prim_order();
-        let normal_idx = if normals.is_some() { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
-        Ok(Mesh { normal_idx, normals, bvh, dropped })
+        let keep_idx = normals.is_some() || uvs.is_some();
+        let vert_idx = if keep_idx { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
+        Ok(Mesh { vert_idx, normals, uvs, bvh, dropped })
     }
 
     /// Closest hit with `0 < t < t_max`. `prim` is the triangle's index in storage order.
@@ -220,7 +227,7 @@ impl Mesh {
         let n = (p1 - p0).cross(p2 - p0).normalize();
         let mut ns = n;
         if let Some(normals) = &self.normals {
-            let [i0, i1, i2] = self.normal_idx[h.slot as usize];
+            let [i0, i1, i2] = self.vert_idx[h.slot as usize];
             let s = normals[i0 as usize] * b0 + normals[i1 as usize] * b1 + normals[i2 as usize] * b2;
             let s = s.normalize_or_zero();
             if s != Vec3::ZERO {
@@ -287,6 +294,21 @@ impl Mesh {
     pub fn has_normals(&self) -> bool {
         self.normals.is_some()
     }
+
+    /// The texture coordinates at barycentrics `(b1, b2)` of triangle `tri` (storage
+    /// order, as `Hit::prim`; the point is `(1 - b1 - b2) p0 + b1 p1 + b2 p2` of
+    /// [`Mesh::triangle`]): the per-vertex uvs interpolated, or without them pbrt's
+    /// default, `(0, 0)`, `(1, 0)`, `(1, 1)` at the triangle's three vertices.
+    /// Textures (issue 35) will call it per hit.
+    #[allow(dead_code)]
+    pub(crate) fn uv(&self, tri: u32, b1: f32, b2: f32) -> [f32; 2] {
+        let b0 = 1.0 - b1 - b2;
+        let [a, b, c] = match &self.uvs {
+            Some(uvs) => self.vert_idx[tri as usize].map(|i| uvs[i as usize]),
+            None => [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]],
+        };
+        [b0 * a[0] + b1 * b[0] + b2 * c[0], b0 * a[1] + b1 * b[1] + b2 * c[1]]
+    }
 }
 
 impl Mesh {
@@ -328,7 +350,9 @@ impl Mesh {
             [4, 5, 7, 6], // +z
         ];
         let tris = faces.iter().flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]]).collect();
-        Mesh::build(corners, tris, None, &Transform::default(), Some(t), &|m| Error::Settings(format!("cuboid: {m}")))
+        Mesh::build(corners, tris, None, None, &Transform::default(), Some(t), &|m| {
+            Error::Settings(format!("cuboid: {m}"))
+        })
     }
 }
 
@@ -542,18 +566,18 @@ mod tests {
         let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
         let t =
             Transform { scale: Vec3::new(2.0, 3.0, 1.0), rotate_deg: Vec3::new(0.0, 0.0, 90.0), translate: Vec3::Z };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &t, None, &|m| Error::Settings(m)).unwrap();
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &t, None, &|m| Error::Settings(m)).unwrap();
         let [a, b, c] = m.triangle(0);
         assert!((a - Vec3::Z).length() < 1e-6);
         assert!((b - Vec3::new(0.0, 2.0, 1.0)).length() < 1e-6, "{b}");
         assert!((c - Vec3::new(-3.0, 0.0, 1.0)).length() < 1e-6, "{c}");
         // Mirroring keeps the front side (normal +z before and after).
         let mirror = Transform { scale: Vec3::new(-1.0, 1.0, 1.0), ..Default::default() };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &mirror, None, &|m| Error::Settings(m)).unwrap();
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &mirror, None, &|m| Error::Settings(m)).unwrap();
         let h = m.intersect(&Ray::new(Vec3::new(-0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
         assert_eq!(h.n, Vec3::Z);
         assert!(
-            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &Transform { scale: Vec3::ZERO, ..t }, None, &|m| {
+            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &Transform { scale: Vec3::ZERO, ..t }, None, &|m| {
                 Error::Settings(m)
             })
             .is_err()
@@ -565,5 +589,31 @@ mod tests {
         assert!(h.ns.z > 0.0 && h.ns.x < 0.0 && (h.ns.length() - 1.0).abs() < 1e-6, "{}", h.ns);
         let e = Mesh::from_triangles(pos, vec![[0, 1, 3]], None).unwrap_err();
         assert!(matches!(e, Error::Settings(_)) && e.to_string().contains("out of range"));
+    }
+
+    #[test]
+    fn uv_interpolates_vertex_uvs_or_takes_pbrts_default() {
+        // A square whose uvs are its (x, y): the uv at any hit is the hit's (x, y).
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let uvs = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let data = MeshData { positions: pos.clone(), triangles: vec![[0, 1, 2], [0, 2, 3]], normals: None };
+        let m = Mesh::from_parts(data, Some(uvs), &Transform::default(), None, &Error::Settings).unwrap();
+        let mut rng = Pcg32::new(5, 1);
+        for _ in 0..200 {
+            let (x, y) = (uniform(&mut rng), uniform(&mut rng));
+            let h = m.intersect(&Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
+            // Barycentrics of the hit in the stored triangle (in the z = 0 plane).
+            let [p0, p1, p2] = m.triangle(h.prim);
+            let (e1, e2, q) = (p1 - p0, p2 - p0, h.p - p0);
+            let det = e1.x * e2.y - e1.y * e2.x;
+            let (b1, b2) = ((q.x * e2.y - q.y * e2.x) / det, (e1.x * q.y - e1.y * q.x) / det);
+            let uv = m.uv(h.prim, b1, b2);
+            assert!((uv[0] - x).abs() < 1e-5 && (uv[1] - y).abs() < 1e-5, "({x}, {y}): {uv:?}");
+        }
+        // Without uvs: (0, 0), (1, 0), (1, 1) at the vertices, linear between.
+        let m = Mesh::from_triangles(pos, vec![[0, 1, 2]], None).unwrap();
+        assert!(m.uvs.is_none() && m.vert_idx.is_empty(), "no cost without uvs");
+        assert_eq!([m.uv(0, 0.0, 0.0), m.uv(0, 1.0, 0.0), m.uv(0, 0.0, 1.0)], [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
+        assert_eq!(m.uv(0, 0.5, 0.25), [0.75, 0.25]);
     }
 }
