@@ -123,7 +123,7 @@ impl Placement {
         }
     }
 
-    /// A point moved by the placement, checked to stay in range (`field`: what it was).
+    /// A point moved by the placement, checked to stay within ±`MAX_MAGNITUDE`.
     pub(crate) fn point(&self, check: &Check, p: Vec3) -> Result<Vec3> {
         self.checked(check, self.t.point(p))
     }
