@@ -226,6 +226,14 @@ fn a_transformed_cuboid_stays_a_box_or_becomes_a_closed_mesh() {
             }
         }
     }
+    // As glass it is a volume that the points inside are in, with its priority.
+    let text = one_object(
+        r#"(shape: Cuboid(min: (-1, -1, -1), max: (1, 1, 1)), material: "glass", priority: 2, transform: (rotate_deg: (0, 30, 10)))"#,
+    );
+    let scene = load_scene_str(&text, Path::new("t.ron"), &Default::default()).unwrap();
+    let inside = scene.volumes_at(Vec3::new(0.2, -0.3, 0.1));
+    assert_eq!(inside.entries().iter().map(|v| (v.object, v.priority)).collect::<Vec<_>>(), [(0, 2)]);
+    assert!(scene.volumes_at(Vec3::new(0.0, 0.0, 2.0)).is_empty(), "outside");
     // It emits like any mesh.
     let text = one_object(
         r#"(shape: Cuboid(min: (0, 0, 0), max: (1, 1, 1)), emission: Constant(1), transform: (rotate_deg: (30, 0, 0)))"#,
