@@ -38,6 +38,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod io;
 pub mod light;
+pub mod material;
 pub mod medium;
 pub mod render;
 pub(crate) mod sampler;

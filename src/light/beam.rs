@@ -8,6 +8,9 @@
 //! lights: [ Beam(origin: (-2, 1, 0), direction: (1, 0, 0), radius: 0.05, irradiance: Scaled(50, EqualEnergy)) ],
 //! ```
 
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{SpectrumDesc, V3};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -67,6 +70,25 @@ impl BeamLight {
     #[inline]
     pub(super) fn pdf_le(&self) -> (f32, f32) {
         (1.0 / (PI * self.radius * self.radius), 1.0)
+    }
+}
+
+impl BeamLight {
+    /// A beam from the scene description at `field` (`lights[i]`).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        origin: V3,
+        direction: V3,
+        radius: f32,
+        irradiance: &SpectrumDesc,
+    ) -> Result<BeamLight> {
+        Ok(BeamLight {
+            origin: check.vec(&format!("{field}.origin"), origin)?,
+            direction: check.direction(&format!("{field}.direction"), direction)?,
+            radius: check.positive(&format!("{field}.radius"), radius)?,
+            irradiance: check.spectrum(&format!("{field}.irradiance"), irradiance)?,
+        })
     }
 }
 

@@ -7,6 +7,9 @@
 //! lights: [ Distant(direction: (-1, -2, -1), irradiance: Scaled(3, D65)) ],
 //! ```
 
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{SpectrumDesc, V3};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -61,5 +64,23 @@ impl DistantLight {
     #[inline]
     pub(super) fn pdf_le(&self) -> (f32, f32) {
         (1.0 / (PI * self.scene_radius * self.scene_radius), 1.0)
+    }
+}
+
+impl DistantLight {
+    /// A distant light from the scene description at `field` (`lights[i]`); the scene
+    /// sets its bounds later.
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        direction: V3,
+        irradiance: &SpectrumDesc,
+    ) -> Result<DistantLight> {
+        Ok(DistantLight {
+            direction: check.direction(&format!("{field}.direction"), direction)?,
+            irradiance: check.spectrum(&format!("{field}.irradiance"), irradiance)?,
+            scene_radius: 1.0,
+            scene_center: Vec3::ZERO,
+        })
     }
 }

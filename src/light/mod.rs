@@ -43,6 +43,10 @@ pub use spot::SpotLight;
 use glam::{Vec2, Vec3};
 
 use crate::color::Spectrum;
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{LightDesc, SpectrumDesc};
+use crate::shape::Shape;
 
 /// The closed set of lights.
 #[derive(Clone, Debug)]
@@ -167,6 +171,56 @@ impl Light {
 #[inline]
 fn sides(two_sided: bool) -> f32 {
     if two_sided { 2.0 } else { 1.0 }
+}
+
+impl Light {
+    /// A light of the `lights:` list from its description at `field` (`lights[i]`),
+    /// built by its own type's `from_desc`.
+    pub(crate) fn from_desc(check: &Check, field: &str, d: &LightDesc) -> Result<Light> {
+        Ok(match d {
+            LightDesc::Point { position, intensity } => {
+                Light::Point(PointLight::from_desc(check, field, *position, intensity)?)
+            }
+            LightDesc::Spot { position, look_at, cone_deg, falloff_deg, intensity } => Light::Spot(
+                SpotLight::from_desc(check, field, *position, *look_at, *cone_deg, *falloff_deg, intensity)?,
+            ),
+            LightDesc::Distant { direction, irradiance } => {
+                Light::Distant(DistantLight::from_desc(check, field, *direction, irradiance)?)
+            }
+            LightDesc::Beam { origin, direction, radius, irradiance } => {
+                Light::Beam(BeamLight::from_desc(check, field, *origin, *direction, *radius, irradiance)?)
+            }
+        })
+    }
+
+    /// The area light of an object (`field`: `objects[i]`) whose `emission` is
+    /// `emission`, emitting from `shape`: spheres, disks, quads, cuboids and meshes
+    /// emit; planes (infinite) and bubbles cannot.
+    pub(crate) fn from_emission(
+        check: &Check,
+        field: &str,
+        shape: &Shape,
+        emission: &SpectrumDesc,
+        two_sided: bool,
+    ) -> Result<Light> {
+        let radiance = check.spectrum(&format!("{field}.emission"), emission)?;
+        let flat = |l: Option<AreaLight>| {
+            l.map(Light::Area).ok_or_else(|| check.err(format!("{field}.shape"), "an emitter needs a non-zero area"))
+        };
+        Ok(match shape {
+            Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided }),
+            Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided }),
+            Shape::Quad(q) => flat(AreaLight::quad(q, radiance, two_sided))?,
+            Shape::Cuboid(c) => flat(AreaLight::cuboid(c, radiance, two_sided))?,
+            Shape::Mesh(m) => flat(AreaLight::mesh(m, radiance, two_sided))?,
+            Shape::Plane(_) | Shape::Bubble(_) => {
+                return Err(check.err(
+                    format!("{field}.emission"),
+                    "a Plane (infinite) or Bubble cannot emit; expected a Sphere, Disk, Quad, Cuboid or Mesh",
+                ));
+            }
+        })
+    }
 }
 
 #[cfg(test)]

@@ -5,6 +5,9 @@
 //! lights: [ Point(position: (0, 1.9, 0), intensity: Scaled(2, D65)) ],
 //! ```
 
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{SpectrumDesc, V3};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -67,5 +70,15 @@ impl PointLight {
     #[inline]
     pub(super) fn pdf_le(&self) -> (f32, f32) {
         (1.0, 1.0 / (4.0 * PI))
+    }
+}
+
+impl PointLight {
+    /// A point light from the scene description at `field` (`lights[i]`).
+    pub(crate) fn from_desc(check: &Check, field: &str, position: V3, intensity: &SpectrumDesc) -> Result<PointLight> {
+        Ok(PointLight {
+            position: check.vec(&format!("{field}.position"), position)?,
+            intensity: check.spectrum(&format!("{field}.intensity"), intensity)?,
+        })
     }
 }

@@ -7,6 +7,9 @@
 //! lights: [ Spot(position: (0, 1.9, 0), look_at: (0, 0, 0), cone_deg: 30, falloff_deg: 5, intensity: Scaled(20, D65)) ],
 //! ```
 
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{SpectrumDesc, V3};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -107,6 +110,37 @@ impl SpotLight {
     pub(super) fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
         let inside = dir.dot(self.axis) >= self.cos_total && self.cos_total < 1.0;
         (1.0, if inside { 1.0 / (2.0 * PI * (1.0 - self.cos_total)) } else { 0.0 })
+    }
+}
+
+impl SpotLight {
+    /// A spot light from the scene description at `field` (`lights[i]`): the cone
+    /// in (0, 90] degrees, the falloff within it.
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        position: V3,
+        look_at: V3,
+        cone_deg: f32,
+        falloff_deg: f32,
+        intensity: &SpectrumDesc,
+    ) -> Result<SpotLight> {
+        let f = |name: &str| format!("{field}.{name}");
+        let position = check.vec(&f("position"), position)?;
+        let target = check.vec(&f("look_at"), look_at)?;
+        let axis =
+            (target - position).try_normalize().ok_or_else(|| check.err(f("look_at"), "must differ from position"))?;
+        if !(cone_deg.is_finite() && cone_deg > 0.0 && cone_deg <= 90.0) {
+            return Err(check.err(f("cone_deg"), format!("expected degrees in (0, 90], found {cone_deg}")));
+        }
+        if !(falloff_deg.is_finite() && (0.0..=cone_deg).contains(&falloff_deg)) {
+            return Err(check.err(
+                f("falloff_deg"),
+                format!("expected degrees from 0 to cone_deg ({cone_deg}), found {falloff_deg}"),
+            ));
+        }
+        let intensity = check.spectrum(&f("intensity"), intensity)?;
+        Ok(SpotLight::new(position, axis, cone_deg, falloff_deg, intensity))
     }
 }
 

@@ -297,6 +297,21 @@ pub enum ShapeDesc {
         /// Second edge.
         edge_v: V3,
     },
+    /// A triangle mesh given inline, built like a mesh file's contents:
+    /// `Triangles(positions: [(0, 0, 0), (1, 0, 0), (1, 1, 0)], indices: [(0, 1, 2)])`.
+    Triangles {
+        /// Vertex positions.
+        positions: Vec<V3>,
+        /// Triangles as indices into `positions`, counter-clockwise seen from the front.
+        indices: Vec<[u32; 3]>,
+        /// Per-vertex shading normals, one per position (default: flat triangles).
+        #[serde(default)]
+        normals: Option<Vec<V3>>,
+        /// Per-vertex texture coordinates `(u, v)`, one per position (kept for textures,
+        /// issue 35; default: none).
+        #[serde(default)]
+        uvs: Option<Vec<[f32; 2]>>,
+    },
     /// A triangle mesh from an OBJ or PLY file (optionally .gz), relative to the scene file.
     Mesh {
         /// The mesh file.
@@ -345,6 +360,32 @@ pub struct ObjectDesc {
     /// [`crate::medium::nested`]; ignored for other materials): `priority: 2`.
     #[serde(default)]
     pub priority: u32,
+    /// Where to place the shape: `transform: (scale: 2, rotate_deg: (0, 45, 0), translate: (1, 0, 0))`
+    /// (default: as given). See [`TransformDesc`] for what each shape accepts.
+    #[serde(default)]
+    pub transform: Option<TransformDesc>,
+}
+
+/// An object's placement, applied to its shape: scale, then rotate about x, then y,
+/// then z (degrees), then translate, each optional; the same meaning and order as a
+/// `Mesh`'s own `scale`, `rotate_deg` and `translate`, which apply first.
+///
+/// Spheres, bubbles and disks take only a uniform scale (a scaled sphere would be an
+/// ellipsoid, a scaled disk an ellipse); planes and quads take any scale; a cuboid
+/// with a rotation becomes a closed mesh of 12 triangles (still a solid for nested
+/// dielectrics), without one it stays an axis-aligned box.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    /// Uniform or per-axis scale, positive (default 1).
+    #[serde(default)]
+    pub scale: Option<ScaleDesc>,
+    /// Rotation in degrees about x, then y, then z (default none).
+    #[serde(default)]
+    pub rotate_deg: Option<V3>,
+    /// Translation (default none).
+    #[serde(default)]
+    pub translate: Option<V3>,
 }
 
 /// A light that is not an object.

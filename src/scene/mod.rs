@@ -7,6 +7,7 @@
 //! when there are enough of them to pay for it; unbounded ones (planes) are
 //! tested one by one.
 
+pub(crate) mod check;
 pub mod desc;
 mod load;
 mod query;

@@ -1,13 +1,12 @@
 //! Spectra and indices of refraction in a scene file, checked: the
 //! `SpectrumDesc` forms (`Constant`, `Samples`, `Table`, `File`, `Rgb`,
 //! named spectra, `Blackbody`, `Luminance`, `Scaled`) become 36-bin
-//! [`Spectrum`]s, and `IorDesc` becomes an [`Ior`]. Part of the scene loader
-//! ([`super::load`]), split out to keep each file about one thing.
+//! [`Spectrum`]s, and `IorDesc` becomes an [`Ior`]. Part of the scene loader's [`Check`], split out to keep each file about one thing.
 
 use std::path::PathBuf;
 
+use super::check::{Check, MAX_MAGNITUDE};
 use super::desc::{IorDesc, SpectrumDesc};
-use super::load::{Ctx, MAX_MAGNITUDE};
 use crate::bxdf::{Ior, NAMED_GLASSES, named_glass};
 use crate::color::{self, N_BINS, Spectrum};
 use crate::error::{Error, Result};
@@ -22,10 +21,10 @@ enum Role {
     Emission,
 }
 
-impl Ctx<'_> {
+impl Check<'_> {
     /// A text file the scene refers to (a spectrum table), read through
-    /// [`Ctx::read_input`] like every input: the resolved path and the text.
-    pub(super) fn read_text_input(&self, field: &str, rel: &str) -> Result<(PathBuf, String)> {
+    /// [`Check::read_input`] like every input: the resolved path and the text.
+    pub(crate) fn read_text_input(&self, field: &str, rel: &str) -> Result<(PathBuf, String)> {
         let (path, bytes) = self.read_input(field, rel)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let at = e.utf8_error().valid_up_to();
@@ -35,7 +34,7 @@ impl Ctx<'_> {
     }
 
     /// Checks a table's points (finite, wavelengths strictly increasing, at least one).
-    pub(super) fn table(&self, field: &str, points: &[(f32, f32)]) -> Result<Spectrum> {
+    pub(crate) fn table(&self, field: &str, points: &[(f32, f32)]) -> Result<Spectrum> {
         if points.is_empty() {
             return Err(self.err(field, "expected at least one (nm, value) pair"));
         }
@@ -57,7 +56,7 @@ impl Ctx<'_> {
     }
 
     /// A spectrum for emission or intensity (any non-negative values).
-    pub(super) fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+    pub(crate) fn spectrum(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
         self.spectrum_as(field, s, Role::Emission)
     }
 
@@ -134,7 +133,7 @@ impl Ctx<'_> {
         Ok(out)
     }
 
-    pub(super) fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
+    pub(crate) fn reflectance(&self, field: &str, s: &SpectrumDesc) -> Result<Spectrum> {
         let r = self.spectrum_as(field, s, Role::Reflectance)?;
         if r.max_value() > 1.0 {
             return Err(self.err(field, format!("a reflectance must lie in [0, 1], found {}", r.max_value())));
@@ -142,7 +141,7 @@ impl Ctx<'_> {
         Ok(r)
     }
 
-    pub(super) fn ior(&self, field: &str, d: &IorDesc) -> Result<Ior> {
+    pub(crate) fn ior(&self, field: &str, d: &IorDesc) -> Result<Ior> {
         let ior = match d {
             IorDesc::Constant(n) => Ior::Constant(*n),
             IorDesc::Cauchy { a, b } => Ior::Cauchy { a: *a, b: *b },

@@ -2,8 +2,12 @@
 //! concentric inner sphere (the cavity). The outer surface's normal points away
 //! from the centre, the inner surface's normal towards it (out of the shell, into the cavity).
 
+use super::Placement;
 use super::sphere::{first_root, reproject, sphere_roots};
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A spherical shell of radii `inner_radius < outer_radius` around `center`.
@@ -51,6 +55,40 @@ impl Bubble {
     pub fn bounds(&self) -> Aabb {
         let r = Vec3::splat(self.outer_radius.abs());
         Aabb::new(self.center - r, self.center + r)
+    }
+}
+
+impl Bubble {
+    /// A bubble from the scene description at `field`: the inner radius must be the
+    /// smaller; placed by `xf` (uniform scale only).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        center: V3,
+        outer_radius: f32,
+        inner_radius: f32,
+        xf: Option<&Placement>,
+    ) -> Result<Bubble> {
+        let f = |name: &str| format!("{field}.{name}");
+        let outer = check.positive(&f("outer_radius"), outer_radius)?;
+        let inner = check.positive(&f("inner_radius"), inner_radius)?;
+        if inner >= outer {
+            return Err(
+                check.err(f("inner_radius"), format!("expected less than outer_radius ({outer}), found {inner}"))
+            );
+        }
+        let center = check.vec(&f("center"), center)?;
+        match xf {
+            None => Ok(Bubble { center, outer_radius: outer, inner_radius: inner }),
+            Some(x) => {
+                let s = x.uniform_scale(check, "bubble")?;
+                let (outer, inner) = (x.length(check, outer, s)?, x.length(check, inner, s)?);
+                if inner >= outer {
+                    return Err(check.err(format!("{}.scale", x.field), "the scale makes the radii equal in f32"));
+                }
+                Ok(Bubble { center: x.point(check, center)?, outer_radius: outer, inner_radius: inner })
+            }
+        }
     }
 }
 

@@ -1,7 +1,11 @@
 //! Cuboids: axis-aligned boxes as solids (normals point outward). A ray starting
 //! inside hits the far face, still with the outward normal.
 
+use super::{Mesh, Placement, Shape};
+use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A solid axis-aligned box `[min, max]`.
@@ -83,6 +87,35 @@ impl Cuboid {
     /// Bounding box (the box itself).
     pub fn bounds(&self) -> Aabb {
         Aabb { min: self.min, max: self.max }
+    }
+}
+
+impl Cuboid {
+    /// A cuboid from the scene description at `field`: `min < max` on every axis;
+    /// placed by `xf`: scaled and translated it stays an axis-aligned [`Cuboid`], with
+    /// any non-zero `rotate_deg` it becomes a closed 12-triangle [`Mesh`] (outward
+    /// normals: still a solid for nested dielectrics).
+    pub(crate) fn from_desc(check: &Check, field: &str, min: V3, max: V3, xf: Option<&Placement>) -> Result<Shape> {
+        let (lo, hi) = (check.vec(&format!("{field}.min"), min)?, check.vec(&format!("{field}.max"), max)?);
+        if !lo.cmplt(hi).all() {
+            return Err(check.err(field, "expected min < max on every axis"));
+        }
+        let Some(x) = xf else {
+            return Ok(Shape::Cuboid(Cuboid { min: lo, max: hi }));
+        };
+        if x.t.rotate_deg == Vec3::ZERO {
+            // Scales are positive, so the corners keep their order.
+            let (lo, hi) = (x.point(check, lo)?, x.point(check, hi)?);
+            if !lo.cmplt(hi).all() {
+                return Err(check.err(format!("{}.scale", x.field), "the scale makes the box flat in f32"));
+            }
+            return Ok(Shape::Cuboid(Cuboid { min: lo, max: hi }));
+        }
+        let mesh = Mesh::cuboid(lo, hi, &x.t).map_err(|e| match e {
+            Error::Setting { name, message } => check.err(format!("{}.{name}", x.field), message),
+            e => check.err(&x.field, e.to_string()),
+        })?;
+        Ok(Shape::Mesh(Box::new(mesh)))
     }
 }
 

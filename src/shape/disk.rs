@@ -1,7 +1,11 @@
 //! Disks: flat circles, one-sided normal given by the user (the same on both sides).
 
+use super::Placement;
 use super::plane::{plane_t, project};
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A disk of radius `radius` around `center` in the plane with unit normal `normal`.
@@ -47,6 +51,34 @@ impl Disk {
         let n = self.normal;
         let e = (Vec3::ONE - n * n).max(Vec3::ZERO).powf(0.5) * self.radius.abs();
         Aabb::new(self.center - e, self.center + e)
+    }
+}
+
+impl Disk {
+    /// A disk from the scene description at `field` (the normal need not be unit),
+    /// placed by `xf` (uniform scale only: a disk scaled otherwise would be an ellipse).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        center: V3,
+        normal: V3,
+        radius: f32,
+        xf: Option<&Placement>,
+    ) -> Result<Disk> {
+        let center = check.vec(&format!("{field}.center"), center)?;
+        let normal = check.direction(&format!("{field}.normal"), normal)?;
+        let radius = check.positive(&format!("{field}.radius"), radius)?;
+        match xf {
+            None => Ok(Disk { center, normal, radius }),
+            Some(x) => {
+                let s = x.uniform_scale(check, "disk")?;
+                Ok(Disk {
+                    center: x.point(check, center)?,
+                    normal: x.normal(check, normal)?,
+                    radius: x.length(check, radius, s)?,
+                })
+            }
+        }
     }
 }
 

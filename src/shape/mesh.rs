@@ -3,6 +3,10 @@
 //! mesh's own [`WideBvh`], which also stores the triangles (four to a block, in leaf
 //! order); `Hit::prim` is a triangle's index in that order (its slot).
 
+use super::Placement;
+use crate::io::parse_mesh;
+use crate::scene::check::Check;
+use crate::scene::desc::{ScaleDesc, V3};
 use std::path::Path;
 
 use glam::{Mat3, Vec3};
@@ -49,10 +53,13 @@ impl Transform {
 /// A triangle mesh with optional per-vertex normals and its own BVH.
 #[derive(Clone, Debug)]
 pub struct Mesh {
-    /// Vertex indices of each triangle (slot order), kept only with normals.
-    normal_idx: Vec<[u32; 3]>,
+    /// Vertex indices of each triangle (slot order), kept only with normals or uvs.
+    vert_idx: Vec<[u32; 3]>,
     /// Unit per-vertex normals, if the file had them.
     normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, if given (for textures, issue 35; no cost
+    /// for a mesh without).
+    uvs: Option<Vec<[f32; 2]>>,
     /// The BVH, which holds the vertices of each triangle in slot order.
     bvh: WideBvh,
     /// Input triangle indices of the dropped zero-area triangles, ascending.
@@ -73,8 +80,31 @@ impl Mesh {
 
     /// [`Mesh::load`] from a mesh file's parsed contents (`path` names it in errors).
     pub fn from_data(data: MeshData, path: &Path, transform: &Transform) -> Result<Mesh> {
+        Mesh::from_data_placed(data, path, transform, None)
+    }
+
+    /// [`Mesh::from_data`], then placed by `then` (an object's transform) when given.
+    pub(crate) fn from_data_placed(
+        data: MeshData,
+        path: &Path,
+        transform: &Transform,
+        then: Option<&Transform>,
+    ) -> Result<Mesh> {
+        Mesh::from_parts(data, None, transform, then, &|m| Error::mesh(path, m))
+    }
+
+    /// A mesh from parsed contents (a file's or an inline description's) and optional
+    /// per-vertex `uvs` (one per position: the caller checks), placed by `transform`
+    /// then `then`; `err` makes the errors about the contents.
+    pub(crate) fn from_parts(
+        data: MeshData,
+        uvs: Option<Vec<[f32; 2]>>,
+        transform: &Transform,
+        then: Option<&Transform>,
+        err: &dyn Fn(String) -> Error,
+    ) -> Result<Mesh> {
         let MeshData { positions, triangles, normals } = data;
-        Mesh::build(positions, triangles, normals, transform, &|m| Error::mesh(path, m))
+        Mesh::build(positions, triangles, normals, uvs, transform, then, err)
     }
 
     /// The raw contents of a mesh file as [`Mesh::load`] reads them, before any transform
@@ -89,32 +119,43 @@ impl Mesh {
     /// A mesh from positions, triangles (indices into `positions`, counter-clockwise
     /// front) and optional per-vertex normals; errors are [`Error::Settings`].
     pub fn from_triangles(positions: Vec<Vec3>, indices: Vec<[u32; 3]>, normals: Option<Vec<Vec3>>) -> Result<Mesh> {
-        Mesh::build(positions, indices, normals, &Transform::default(), &|m| Error::Settings(format!("mesh: {m}")))
+        Mesh::build(positions, indices, normals, None, &Transform::default(), None, &|m| {
+            Error::Settings(format!("mesh: {m}"))
+        })
     }
 
     fn build(
         mut positions: Vec<Vec3>,
         indices: Vec<[u32; 3]>,
         mut normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<[f32; 2]>>,
         transform: &Transform,
+        then: Option<&Transform>,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
         let setting = |name, message| Error::Setting { name, message };
-        if !transform.rotate_deg.is_finite() {
-            return Err(setting("rotate_deg", format!("expected finite angles, found {}", transform.rotate_deg)));
+        for t in std::iter::once(transform).chain(then) {
+            if !t.rotate_deg.is_finite() {
+                return Err(setting("rotate_deg", format!("expected finite angles, found {}", t.rotate_deg)));
+            }
+            if !t.translate.is_finite() {
+                return Err(setting("translate", format!("expected finite coordinates, found {}", t.translate)));
+            }
         }
-        if !transform.translate.is_finite() {
-            return Err(setting("translate", format!("expected finite coordinates, found {}", transform.translate)));
-        }
-        let m = transform.linear();
+        // The mesh's own placement, then the object's (`then`): one affine map.
+        let (m, translate) = match then {
+            None => (transform.linear(), transform.translate),
+            Some(o) => {
+                let lo = o.linear();
+                (lo * transform.linear(), lo * transform.translate + o.translate)
+            }
+        };
         let det = m.determinant();
         if !(det != 0.0 && det.is_finite()) {
+            let scale = then.map_or(transform.scale, |o| o.scale * transform.scale);
             return Err(setting(
                 "scale",
-                format!(
-                    "the scale {} makes the transform singular in f32 (its determinant is {det:e})",
-                    transform.scale
-                ),
+                format!("the scale {scale} makes the transform singular in f32 (its determinant is {det:e})"),
             ));
         }
         if let Some(ns) = &normals
@@ -126,7 +167,7 @@ impl Mesh {
             if !p.is_finite() {
                 return Err(err(format!("vertex {i} has a non-finite coordinate {p}")));
             }
-            *p = m * *p + transform.translate;
+            *p = m * *p + translate;
             if !p.is_finite() {
                 return Err(setting(
                     "scale",
@@ -167,8 +208,9 @@ impl Mesh {
         }
         let bvh = WideBvh::build_indexed(&positions, &kept);
         let order = bvh.prim_order();
-        let normal_idx = if normals.is_some() { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
-        Ok(Mesh { normal_idx, normals, bvh, dropped })
+        let keep_idx = normals.is_some() || uvs.is_some();
+        let vert_idx = if keep_idx { order.iter().map(|&i| kept[i as usize]).collect() } else { Vec::new() };
+        Ok(Mesh { vert_idx, normals, uvs, bvh, dropped })
     }
 
     /// Closest hit with `0 < t < t_max`. `prim` is the triangle's index in storage order.
@@ -185,7 +227,7 @@ impl Mesh {
         let n = (p1 - p0).cross(p2 - p0).normalize();
         let mut ns = n;
         if let Some(normals) = &self.normals {
-            let [i0, i1, i2] = self.normal_idx[h.slot as usize];
+            let [i0, i1, i2] = self.vert_idx[h.slot as usize];
             let s = normals[i0 as usize] * b0 + normals[i1 as usize] * b1 + normals[i2 as usize] * b2;
             let s = s.normalize_or_zero();
             if s != Vec3::ZERO {
@@ -251,6 +293,66 @@ impl Mesh {
     /// True if the mesh has per-vertex normals.
     pub fn has_normals(&self) -> bool {
         self.normals.is_some()
+    }
+
+    /// The texture coordinates at barycentrics `(b1, b2)` of triangle `tri` (storage
+    /// order, as `Hit::prim`; the point is `(1 - b1 - b2) p0 + b1 p1 + b2 p2` of
+    /// [`Mesh::triangle`]): the per-vertex uvs interpolated, or without them pbrt's
+    /// default, `(0, 0)`, `(1, 0)`, `(1, 1)` at the triangle's three vertices.
+    /// Textures (issue 35) will call it per hit.
+    #[allow(dead_code)]
+    pub(crate) fn uv(&self, tri: u32, b1: f32, b2: f32) -> [f32; 2] {
+        let b0 = 1.0 - b1 - b2;
+        let [a, b, c] = match &self.uvs {
+            Some(uvs) => self.vert_idx[tri as usize].map(|i| uvs[i as usize]),
+            None => [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]],
+        };
+        [b0 * a[0] + b1 * b[0] + b2 * c[0], b0 * a[1] + b1 * b[1] + b2 * c[1]]
+    }
+}
+
+impl Mesh {
+    /// A mesh from the scene description at `field`: the file `path` (relative to the
+    /// scene file, recorded in the scene's identity), placed by its own transform.
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        path: &str,
+        scale: &Option<ScaleDesc>,
+        rotate_deg: &Option<V3>,
+        translate: &Option<V3>,
+        xf: Option<&Placement>,
+    ) -> Result<Mesh> {
+        let f = |name: &str| format!("{field}.{name}");
+        let transform = check.transform(field, scale, rotate_deg, translate)?;
+        let (file, bytes) = check.read_input(&f("path"), path)?;
+        let data = parse_mesh(bytes, &file).map_err(|e| check.err(f("path"), e.to_string()))?;
+        Mesh::from_data_placed(data, &file, &transform, xf.map(|x| &x.t)).map_err(|e| match (e, xf) {
+            // A transform that breaks the composed placement is the object's when it has one.
+            (Error::Setting { name, message }, Some(x)) => check.err(format!("{}.{name}", x.field), message),
+            (Error::Setting { name, message }, None) => check.err(f(name), message),
+            (e, _) => check.err(f("path"), e.to_string()),
+        })
+    }
+
+    /// A cuboid `[min, max]` placed by `t` as a closed mesh of 12 triangles, wound
+    /// counter-clockwise seen from outside (outward normals: still a solid).
+    pub(crate) fn cuboid(min: Vec3, max: Vec3, t: &Transform) -> Result<Mesh> {
+        let corners: Vec<Vec3> =
+            (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), max, min)).collect();
+        // Corner i has x = bit 0, y = bit 1, z = bit 2; two triangles per face.
+        let faces: [[u32; 4]; 6] = [
+            [0, 4, 6, 2], // -x
+            [1, 3, 7, 5], // +x
+            [0, 1, 5, 4], // -y
+            [2, 6, 7, 3], // +y
+            [0, 2, 3, 1], // -z
+            [4, 5, 7, 6], // +z
+        ];
+        let tris = faces.iter().flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]]).collect();
+        Mesh::build(corners, tris, None, None, &Transform::default(), Some(t), &|m| {
+            Error::Settings(format!("cuboid: {m}"))
+        })
     }
 }
 
@@ -464,18 +566,18 @@ mod tests {
         let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
         let t =
             Transform { scale: Vec3::new(2.0, 3.0, 1.0), rotate_deg: Vec3::new(0.0, 0.0, 90.0), translate: Vec3::Z };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &t, &|m| Error::Settings(m)).unwrap();
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &t, None, &|m| Error::Settings(m)).unwrap();
         let [a, b, c] = m.triangle(0);
         assert!((a - Vec3::Z).length() < 1e-6);
         assert!((b - Vec3::new(0.0, 2.0, 1.0)).length() < 1e-6, "{b}");
         assert!((c - Vec3::new(-3.0, 0.0, 1.0)).length() < 1e-6, "{c}");
         // Mirroring keeps the front side (normal +z before and after).
         let mirror = Transform { scale: Vec3::new(-1.0, 1.0, 1.0), ..Default::default() };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &mirror, &|m| Error::Settings(m)).unwrap();
+        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &mirror, None, &|m| Error::Settings(m)).unwrap();
         let h = m.intersect(&Ray::new(Vec3::new(-0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
         assert_eq!(h.n, Vec3::Z);
         assert!(
-            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, &Transform { scale: Vec3::ZERO, ..t }, &|m| {
+            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &Transform { scale: Vec3::ZERO, ..t }, None, &|m| {
                 Error::Settings(m)
             })
             .is_err()
@@ -487,5 +589,31 @@ mod tests {
         assert!(h.ns.z > 0.0 && h.ns.x < 0.0 && (h.ns.length() - 1.0).abs() < 1e-6, "{}", h.ns);
         let e = Mesh::from_triangles(pos, vec![[0, 1, 3]], None).unwrap_err();
         assert!(matches!(e, Error::Settings(_)) && e.to_string().contains("out of range"));
+    }
+
+    #[test]
+    fn uv_interpolates_vertex_uvs_or_takes_pbrts_default() {
+        // A square whose uvs are its (x, y): the uv at any hit is the hit's (x, y).
+        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let uvs = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let data = MeshData { positions: pos.clone(), triangles: vec![[0, 1, 2], [0, 2, 3]], normals: None };
+        let m = Mesh::from_parts(data, Some(uvs), &Transform::default(), None, &Error::Settings).unwrap();
+        let mut rng = Pcg32::new(5, 1);
+        for _ in 0..200 {
+            let (x, y) = (uniform(&mut rng), uniform(&mut rng));
+            let h = m.intersect(&Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
+            // Barycentrics of the hit in the stored triangle (in the z = 0 plane).
+            let [p0, p1, p2] = m.triangle(h.prim);
+            let (e1, e2, q) = (p1 - p0, p2 - p0, h.p - p0);
+            let det = e1.x * e2.y - e1.y * e2.x;
+            let (b1, b2) = ((q.x * e2.y - q.y * e2.x) / det, (e1.x * q.y - e1.y * q.x) / det);
+            let uv = m.uv(h.prim, b1, b2);
+            assert!((uv[0] - x).abs() < 1e-5 && (uv[1] - y).abs() < 1e-5, "({x}, {y}): {uv:?}");
+        }
+        // Without uvs: (0, 0), (1, 0), (1, 1) at the vertices, linear between.
+        let m = Mesh::from_triangles(pos, vec![[0, 1, 2]], None).unwrap();
+        assert!(m.uvs.is_none() && m.vert_idx.is_empty(), "no cost without uvs");
+        assert_eq!([m.uv(0, 0.0, 0.0), m.uv(0, 1.0, 0.0), m.uv(0, 0.0, 1.0)], [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
+        assert_eq!(m.uv(0, 0.5, 0.25), [0.75, 0.25]);
     }
 }

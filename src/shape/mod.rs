@@ -16,6 +16,7 @@ mod bubble;
 mod bvh;
 mod cuboid;
 mod disk;
+mod inline;
 mod mesh;
 mod plane;
 mod quad;
@@ -34,7 +35,11 @@ pub use quad::Quad;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::{Check, MAX_MAGNITUDE};
+use crate::scene::desc::ShapeDesc;
+use glam::Vec3;
 
 /// Any shape of the renderer.
 #[derive(Clone, Debug)]
@@ -98,10 +103,105 @@ impl Shape {
     }
 }
 
+/// An object's `transform:` ([`crate::scene::desc::TransformDesc`]), checked, with its
+/// field path (`objects[i].transform`) for errors.
+#[derive(Clone, Debug)]
+pub(crate) struct Placement {
+    /// The field path of the `transform:` block.
+    pub(crate) field: String,
+    /// The placement.
+    pub(crate) t: Transform,
+}
+
+impl Placement {
+    /// The scale factor of a shape that takes only a uniform scale (`what`: "sphere").
+    pub(crate) fn uniform_scale(&self, check: &Check, what: &str) -> Result<f32> {
+        let s = self.t.scale;
+        if s.x == s.y && s.y == s.z {
+            Ok(s.x)
+        } else {
+            Err(check.err(format!("{}.scale", self.field), format!("a {what} takes only a uniform scale, found {s}")))
+        }
+    }
+
+    /// A point moved by the placement, checked to stay within ±`MAX_MAGNITUDE`.
+    pub(crate) fn point(&self, check: &Check, p: Vec3) -> Result<Vec3> {
+        self.checked(check, self.t.point(p))
+    }
+
+    /// A vector (an edge) mapped by the placement's linear part, checked to stay in range.
+    pub(crate) fn vector(&self, check: &Check, v: Vec3) -> Result<Vec3> {
+        self.checked(check, self.t.linear() * v)
+    }
+
+    /// A unit normal mapped by the inverse transpose of the linear part and renormalised.
+    pub(crate) fn normal(&self, check: &Check, n: Vec3) -> Result<Vec3> {
+        (self.t.linear().inverse().transpose() * n).try_normalize().ok_or_else(|| {
+            check.err(format!("{}.scale", self.field), "the transform makes the shape's normal degenerate in f32")
+        })
+    }
+
+    /// A length scaled by a uniform factor, checked to stay a positive size.
+    pub(crate) fn length(&self, check: &Check, len: f32, s: f32) -> Result<f32> {
+        check.positive(&format!("{}.scale", self.field), len * s).map_err(|_| {
+            check.err(
+                format!("{}.scale", self.field),
+                format!("the scale {s} makes a size of {len} leave (0, {MAX_MAGNITUDE:e}]"),
+            )
+        })
+    }
+
+    fn checked(&self, check: &Check, v: Vec3) -> Result<Vec3> {
+        check.vec(&self.field, v.into()).map_err(|_| {
+            check.err(
+                &self.field,
+                format!(
+                    "the transform moves the shape out of range: {v}, expected coordinates up to ±{MAX_MAGNITUDE:e}"
+                ),
+            )
+        })
+    }
+}
+
+impl Shape {
+    /// The shape of a scene description at `field` (`objects[i].shape`), placed by the
+    /// object's transform `xf` when it has one; each shape is built and checked by its
+    /// own type's `from_desc`.
+    pub(crate) fn from_desc(check: &Check, field: &str, d: &ShapeDesc, xf: Option<&Placement>) -> Result<Shape> {
+        Ok(match d {
+            ShapeDesc::Sphere { center, radius } => {
+                Shape::Sphere(Sphere::from_desc(check, field, *center, *radius, xf)?)
+            }
+            ShapeDesc::Bubble { center, outer_radius, inner_radius } => {
+                Shape::Bubble(Bubble::from_desc(check, field, *center, *outer_radius, *inner_radius, xf)?)
+            }
+            ShapeDesc::Plane { point, normal } => Shape::Plane(Plane::from_desc(check, field, *point, *normal, xf)?),
+            ShapeDesc::Disk { center, normal, radius } => {
+                Shape::Disk(Disk::from_desc(check, field, *center, *normal, *radius, xf)?)
+            }
+            ShapeDesc::Cuboid { min, max } => Cuboid::from_desc(check, field, *min, *max, xf)?,
+            ShapeDesc::Quad { origin, edge_u, edge_v } => {
+                Shape::Quad(Quad::from_desc(check, field, *origin, *edge_u, *edge_v, xf)?)
+            }
+            ShapeDesc::Triangles { positions, indices, normals, uvs } => Shape::Mesh(Box::new(Mesh::from_inline_desc(
+                check,
+                field,
+                positions,
+                indices,
+                normals.as_deref(),
+                uvs.as_deref(),
+                xf,
+            )?)),
+            ShapeDesc::Mesh { path, scale, rotate_deg, translate } => {
+                Shape::Mesh(Box::new(Mesh::from_desc(check, field, path, scale, rotate_deg, translate, xf)?))
+            }
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
 
     #[test]
     fn dispatch_agrees_with_shapes() {

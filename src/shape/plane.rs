@@ -1,6 +1,10 @@
 //! Infinite planes (unbounded, so they live outside the scene BVH).
 
+use super::Placement;
+use crate::error::Result;
 use crate::geometry::{Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// The infinite plane through `point` with unit normal `normal` (the same normal on both sides).
@@ -49,6 +53,25 @@ impl Plane {
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         plane_t(self.normal, self.normal.dot(self.point), ray, t_max).is_some()
+    }
+}
+
+impl Plane {
+    /// A plane from the scene description at `field` (the normal need not be unit),
+    /// placed by `xf` (any scale).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        point: V3,
+        normal: V3,
+        xf: Option<&Placement>,
+    ) -> Result<Plane> {
+        let point = check.vec(&format!("{field}.point"), point)?;
+        let normal = check.direction(&format!("{field}.normal"), normal)?;
+        match xf {
+            None => Ok(Plane { point, normal }),
+            Some(x) => Ok(Plane { point: x.point(check, point)?, normal: x.normal(check, normal)? }),
+        }
     }
 }
 

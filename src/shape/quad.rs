@@ -1,8 +1,12 @@
 //! Quads: parallelograms `origin + a * edge_u + b * edge_v`, `a, b` in [0, 1], with
 //! normal `normalize(edge_u x edge_v)` (the same on both sides). Typical area lights.
 
+use super::Placement;
 use super::plane::plane_t;
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A parallelogram, with the plane and the coordinate projection precomputed
@@ -96,6 +100,33 @@ impl Quad {
         Aabb::new(self.origin, self.origin + self.edge_u)
             .grow(self.origin + self.edge_v)
             .grow(self.origin + self.edge_u + self.edge_v)
+    }
+}
+
+impl Quad {
+    /// A quad from the scene description at `field`: the edges must span a
+    /// parallelogram; placed by `xf` (any scale: the image of a parallelogram is one).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        origin: V3,
+        edge_u: V3,
+        edge_v: V3,
+        xf: Option<&Placement>,
+    ) -> Result<Quad> {
+        let (u, v) = (check.vec(&format!("{field}.edge_u"), edge_u)?, check.vec(&format!("{field}.edge_v"), edge_v)?);
+        if u.cross(v).length_squared() <= f32::MIN_POSITIVE {
+            return Err(check.err(field, "edge_u and edge_v must be non-zero and not parallel"));
+        }
+        let origin = check.vec(&format!("{field}.origin"), origin)?;
+        let Some(x) = xf else {
+            return Ok(Quad::new(origin, u, v));
+        };
+        let (u, v) = (x.vector(check, u)?, x.vector(check, v)?);
+        if !(u.cross(v).length_squared() > f32::MIN_POSITIVE) {
+            return Err(check.err(format!("{}.scale", x.field), "the transform makes the quad degenerate in f32"));
+        }
+        Ok(Quad::new(x.point(check, origin)?, u, v))
     }
 }
 

@@ -1,7 +1,11 @@
 //! Spheres, intersected with the numerically stable quadratic and hit points
 //! re-projected onto the surface (so spawned rays do not re-hit it).
 
+use super::Placement;
+use crate::error::Result;
 use crate::geometry::{Aabb, Hit, Ray};
+use crate::scene::check::Check;
+use crate::scene::desc::V3;
 use glam::Vec3;
 
 /// A solid sphere; its normal points outward.
@@ -105,6 +109,28 @@ impl Sphere {
     pub fn bounds(&self) -> Aabb {
         let r = Vec3::splat(self.radius.abs());
         Aabb::new(self.center - r, self.center + r)
+    }
+}
+
+impl Sphere {
+    /// A sphere from the scene description at `field` (`objects[i].shape`), placed by
+    /// `xf` (uniform scale only).
+    pub(crate) fn from_desc(
+        check: &Check,
+        field: &str,
+        center: V3,
+        radius: f32,
+        xf: Option<&Placement>,
+    ) -> Result<Sphere> {
+        let center = check.vec(&format!("{field}.center"), center)?;
+        let radius = check.positive(&format!("{field}.radius"), radius)?;
+        match xf {
+            None => Ok(Sphere::new(center, radius)),
+            Some(x) => {
+                let s = x.uniform_scale(check, "sphere")?;
+                Ok(Sphere::new(x.point(check, center)?, x.length(check, radius, s)?))
+            }
+        }
     }
 }
 

@@ -1,0 +1,127 @@
+//! Materials: a material is built from its description once at load; `bxdf/`
+//! stays the pure lobes (reflection models that know nothing of the scene
+//! format); textures (issue 35) will make this per-hit evaluation.
+//!
+//! Data flow: `MaterialDesc` (the RON text, [`crate::scene::desc`]) →
+//! `from_desc` here (checks every field, looks up named metals and glasses,
+//! builds spectra and indices) → [`Bxdf`] (stored once per named material in
+//! [`crate::scene::Scene::materials`]; objects refer to it by index).
+//!
+//! Errors name the scene file and the field path
+//! (`materials."gold".roughness`) and what was expected.
+
+use crate::bxdf::{
+    Bxdf, Conductor, Dielectric, Lambertian, Mirror, NAMED_METALS, OrenNayar, Plastic, ThinFilm, ThinSheet, named_metal,
+};
+use crate::color::{self, N_BINS};
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{CoatingDesc, IorDesc, MaterialDesc};
+
+/// The [`Bxdf`] of a material description at `field` (`materials."name"`).
+pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<Bxdf> {
+    Ok(match d {
+        MaterialDesc::Lambertian { reflectance } => Bxdf::Lambertian(Lambertian {
+            reflectance: check.reflectance(&format!("{field}.reflectance"), reflectance)?,
+        }),
+        MaterialDesc::OrenNayar { reflectance, sigma_deg } => {
+            if !(sigma_deg.is_finite() && (0.0..=90.0).contains(sigma_deg)) {
+                return Err(
+                    check.err(format!("{field}.sigma_deg"), format!("expected degrees in [0, 90], found {sigma_deg}"))
+                );
+            }
+            Bxdf::OrenNayar(OrenNayar::new(
+                check.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                *sigma_deg,
+            ))
+        }
+        MaterialDesc::Mirror { reflectance } => {
+            Bxdf::Mirror(Mirror { reflectance: check.reflectance(&format!("{field}.reflectance"), reflectance)? })
+        }
+        MaterialDesc::Dielectric { ior, roughness, absorption, coating } => {
+            let mut d = Dielectric::new(check.ior(&format!("{field}.ior"), ior)?).with_roughness(ggx_alpha(
+                check,
+                &format!("{field}.roughness"),
+                *roughness,
+            )?);
+            if let Some(a) = absorption {
+                d = d.with_absorption(check.spectrum(&format!("{field}.absorption"), a)?);
+            }
+            if let Some(CoatingDesc::ThinFilm { thickness_nm, ior }) = coating {
+                d = d.with_coating(thin_film(check, &format!("{field}.coating"), *thickness_nm, ior)?);
+            }
+            Bxdf::Dielectric(d)
+        }
+        MaterialDesc::Conductor { metal, eta, k, roughness, coating } => {
+            let (eta, k) = match (metal, eta, k) {
+                (Some(name), None, None) => named_metal(name).ok_or_else(|| {
+                    let names: Vec<&str> = NAMED_METALS.iter().map(|m| m.0).collect();
+                    check.err(
+                        format!("{field}.metal"),
+                        format!("unknown metal \"{name}\"; expected one of: {}", names.join(", ")),
+                    )
+                })?,
+                (None, Some(eta), Some(k)) => {
+                    let eta_s = check.spectrum(&format!("{field}.eta"), eta)?;
+                    if eta_s.min_value() <= 0.0 {
+                        return Err(check.err(format!("{field}.eta"), "expected a positive index at every wavelength"));
+                    }
+                    (eta_s, check.spectrum(&format!("{field}.k"), k)?)
+                }
+                _ => {
+                    return Err(check.err(field, "expected either `metal: \"Au\"` or both `eta:` and `k:` spectra"));
+                }
+            };
+            let coating = match coating {
+                None => None,
+                Some(CoatingDesc::ThinFilm { thickness_nm, ior }) => {
+                    Some(thin_film(check, &format!("{field}.coating"), *thickness_nm, ior)?)
+                }
+            };
+            let alpha = ggx_alpha(check, &format!("{field}.roughness"), *roughness)?;
+            Bxdf::Conductor(Conductor { eta, k, alpha, coating })
+        }
+        MaterialDesc::Plastic { reflectance, ior, roughness } => {
+            let ior = check.ior(&format!("{field}.ior"), ior)?;
+            for b in 0..N_BINS {
+                let n = ior.at(color::bin_lambda_nm(b));
+                if n < 1.0 {
+                    return Err(check.err(
+                        format!("{field}.ior"),
+                        format!("a coat's index must be at least 1, found {n} at {} nm", color::bin_lambda_nm(b)),
+                    ));
+                }
+            }
+            Bxdf::Plastic(Plastic::new(
+                check.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                &ior,
+                ggx_alpha(check, &format!("{field}.roughness"), *roughness)?,
+            ))
+        }
+        MaterialDesc::ThinSheet { thickness_nm, ior } => {
+            Bxdf::ThinSheet(ThinSheet { film: thin_film(check, field, *thickness_nm, ior)? })
+        }
+        MaterialDesc::Black => Bxdf::Black,
+    })
+}
+
+/// A thin film: a thickness in [0, 1e7] nm and an index of at least 1.
+fn thin_film(check: &Check, field: &str, thickness_nm: f32, ior: &IorDesc) -> Result<ThinFilm> {
+    if !(thickness_nm.is_finite() && (0.0..=1e7).contains(&thickness_nm)) {
+        return Err(check.err(
+            format!("{field}.thickness_nm"),
+            format!("expected a thickness in nm in [0, 1e7], found {thickness_nm}"),
+        ));
+    }
+    let ior = check.ior(&format!("{field}.ior"), ior)?;
+    Ok(ThinFilm::new(thickness_nm, &ior))
+}
+
+/// A GGX α: a number in [0, 1] (0 is smooth).
+fn ggx_alpha(check: &Check, field: &str, alpha: f32) -> Result<f32> {
+    if alpha.is_finite() && (0.0..=1.0).contains(&alpha) {
+        Ok(alpha)
+    } else {
+        Err(check.err(field, format!("expected a GGX alpha in [0, 1], found {alpha}")))
+    }
+}
