@@ -401,3 +401,27 @@ fn bad_inline_meshes_name_the_field() {
         assert!(e.contains(&format!("t.ron: {field}: ")) && e.contains(message), "{body}: {e}");
     }
 }
+
+/// An inline mesh's per-vertex uvs are interpolated at a hit: a square
+/// `(-1..1)²` in the z = 0 plane with uvs (0,0), (1,0), (1,1), (0,1) at its
+/// corners gives `((x + 1) / 2, (y + 1) / 2)` at every point, on both of its
+/// triangles (an affine map, so interpolation is exact up to rounding). Without
+/// uvs each triangle gets pbrt's default, so the same points differ.
+#[test]
+fn inline_mesh_uvs_are_interpolated_at_hits() {
+    let with = r#"(shape: Triangles(positions: [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], indices: [(0, 1, 2), (0, 2, 3)], uvs: [(0, 0), (1, 0), (1, 1), (0, 1)]), material: "white")"#;
+    let without = r#"(shape: Triangles(positions: [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], indices: [(0, 1, 2), (0, 2, 3)]), material: "white")"#;
+    let load = |o: &str| load_scene_str(&one_object(o), Path::new("t.ron"), &Default::default()).unwrap();
+    let (a, b) = (load(with), load(without));
+    let mut differs = false;
+    for (x, y) in [(0.5f32, -0.25f32), (-0.6, 0.7), (0.1, 0.05), (-0.9, -0.2)] {
+        let ray = Ray::new(Vec3::new(x, y, 3.0), Vec3::new(0.0, 0.0, -1.0));
+        let si = a.intersect(&ray, f32::INFINITY).expect("hits the square");
+        let uv = a.uv(&si);
+        let want = glam::Vec2::new((x + 1.0) / 2.0, (y + 1.0) / 2.0);
+        assert!((uv - want).abs().max_element() < 1e-5, "({x}, {y}): {uv} want {want}");
+        let si = b.intersect(&ray, f32::INFINITY).unwrap();
+        differs |= (b.uv(&si) - want).abs().max_element() > 1e-3;
+    }
+    assert!(differs, "without uvs the default per-triangle mapping applies");
+}

@@ -299,8 +299,7 @@ impl Mesh {
     /// order, as `Hit::prim`; the point is `(1 - b1 - b2) p0 + b1 p1 + b2 p2` of
     /// [`Mesh::triangle`]): the per-vertex uvs interpolated, or without them pbrt's
     /// default, `(0, 0)`, `(1, 0)`, `(1, 1)` at the triangle's three vertices.
-    /// Textures (issue 35) will call it per hit.
-    #[allow(dead_code)]
+    /// [`Shape::uv`](super::Shape::uv) calls it, only where a material asks.
     pub(crate) fn uv(&self, tri: u32, b1: f32, b2: f32) -> [f32; 2] {
         let b0 = 1.0 - b1 - b2;
         let [a, b, c] = match &self.uvs {
