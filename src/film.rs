@@ -216,15 +216,22 @@ impl Film {
         Ok(self)
     }
 
-    /// The most memory a render of a `width` x `height` film takes at once,
-    /// in bytes: the film's sums (48 bytes a pixel), a batch's sample
-    /// buffers (12 bytes a pixel a pass), and a checkpoint being encoded
-    /// (up to 51 bytes a pixel, twice: bincode, then lz4); a spectral film
-    /// adds 36 sums (576 bytes), 36 floats of samples (144) and their
-    /// encoding (up to 612, twice). Renders refuse sizes this machine cannot
-    /// hold before allocating anything.
+    /// The most memory a render of a `width` x `height` film takes, in bytes
+    /// (a bound: the parts are not all held at once): the film's sums (48
+    /// bytes a pixel), a batch's sample buffers (12 bytes a pixel a pass: one
+    /// pass from 512² up; smaller images hold a few passes, at most 64 MiB), a
+    /// checkpoint being encoded (up to 51 bytes a pixel, twice: bincode, then
+    /// lz4) and the output image being made (the mean colour in f64, 24 bytes,
+    /// its 16-bit or f32 copy, 12, and the encoded file and the encoder's
+    /// buffers, up to 36); a spectral film adds 36 sums (576 bytes), 36 floats
+    /// of samples (160 with alignment), their encoding (up to 612, twice) and
+    /// the EXR's 36 channels (144 bytes, copied once by the encoder, and
+    /// encoded: 432). Renders refuse sizes the process cannot hold before
+    /// allocating anything (`ulimit -v` and cgroup limits included): a render
+    /// that passes the check does not abort at its end for want of memory.
     pub fn bytes_needed(width: u32, height: u32, spectral: bool) -> u64 {
-        let per_pixel = 48 + 12 + 2 * 51 + if spectral { 576 + 144 + 2 * 612 } else { 0 };
+        let output = 24 + 12 + 36;
+        let per_pixel = 48 + 12 + 2 * 51 + output + if spectral { 576 + 160 + 2 * 612 + 432 } else { 0 };
         width as u64 * height as u64 * per_pixel
     }
 

@@ -14,6 +14,7 @@ mod furnace;
 mod fuzz;
 mod hostile;
 mod lights;
+mod memory;
 mod metrics;
 mod output;
 mod sampler;

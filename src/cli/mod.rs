@@ -11,6 +11,7 @@
 
 pub mod args;
 mod console;
+mod memory;
 mod render;
 mod session;
 mod study;

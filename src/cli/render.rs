@@ -267,24 +267,21 @@ fn check_files(
     Ok(())
 }
 
-/// Refuses a film larger than the memory this machine has available (Linux:
-/// `MemAvailable` in /proc/meminfo; elsewhere not checked).
+/// Refuses a render larger than the memory this process may take: the least of
+/// what the machine has available, what its address-space limit (`ulimit -v`)
+/// leaves and what its cgroup leaves ([`super::memory`]). Not checked where none
+/// can be read.
 fn check_memory(width: u32, height: u32, spectral: bool) -> Result<()> {
     let need = Film::bytes_needed(width, height, spectral);
-    let Some(available) = available_memory() else { return Ok(()) };
-    if need > available {
+    let Some(budget) = super::memory::budget() else { return Ok(()) };
+    if need > budget.bytes {
         return Err(Error::Settings(format!(
-            "a {width}x{height} render needs about {:.1} GB of memory; this machine has {:.1} GB available",
+            "a {width}x{height} render{} needs about {:.1} GB of memory; {} {:.1} GB",
+            if spectral { " with --spectral" } else { "" },
             need as f64 / 1e9,
-            available as f64 / 1e9
+            budget.limit,
+            budget.bytes as f64 / 1e9
         )));
     }
     Ok(())
-}
-
-fn available_memory() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }

@@ -171,6 +171,10 @@ impl Session {
             view.note(format_args!("continue with: rust-v resume {}", saved.display()));
         }
         if !stats.interrupted {
+            // The checkpoint first: making the image allocates its buffers, and a
+            // failed allocation aborts the process (the up-front memory check makes
+            // that unlikely, not impossible), which must not lose the passes.
+            let checkpoint = if plan.final_checkpoint && !stopped { Some(save_work(&ckpt, plan, None)?) } else { None };
             if let Err(e) = ckpt.film.write(&plan.output) {
                 let saved = save_work(&ckpt, plan, Some(&e))?;
                 return Err(Error::Settings(format!(
@@ -180,8 +184,7 @@ impl Session {
                     saved.display()
                 )));
             }
-            if plan.final_checkpoint && !stopped {
-                let saved = save_work(&ckpt, plan, None)?;
+            if let Some(saved) = checkpoint {
                 view.note(format_args!("wrote checkpoint {}", saved.display()));
             }
             report(scene, &stats, &plan.output, plan.quiet);
