@@ -437,3 +437,27 @@ fn spectral_films_merge_and_resume_bit_identically() {
     let bytes = meta(&scene, plain).encode().unwrap();
     assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), rust_v::checkpoint::FORMAT_VERSION);
 }
+
+/// Issue 34 item 6: `resume CKPT --checkpoint CKPT` names resume's own default
+/// and is accepted (it was refused as "overwriting an input"), and a finished
+/// resume leaves its checkpoint holding every pass, so a second resume of the
+/// same file continues from there (it restarted from the old pass count: the
+/// passes in between lived only in the image).
+#[test]
+fn resume_keeps_its_checkpoint_up_to_date() {
+    let dir = temp_dir("resume-own-checkpoint");
+    let scene = root().join("scenes/cornell.ron");
+    let ckpt = dir.join("long.ckpt");
+    ok(&render_part(&scene, &dir.join("a.exr"), &ckpt, &["--spp", "3"]));
+    // The same file named explicitly, also through another spelling of its path.
+    let other = dir.join(".").join("long.ckpt");
+    ok(&rust_v(&["resume", s(&ckpt), "--spp", "5", "--checkpoint", s(&other), "-o", s(&dir.join("b.exr")), "--quiet"]));
+    assert_eq!(Checkpoint::read(&ckpt).unwrap().passes(), 0..5);
+    // Without --checkpoint the resumed file is updated too.
+    ok(&rust_v(&["resume", s(&ckpt), "--spp", "8", "-o", s(&dir.join("c.exr")), "--quiet"]));
+    assert_eq!(Checkpoint::read(&ckpt).unwrap().passes(), 0..8);
+    // And it is exactly a render of 8 passes.
+    ok(&render_part(&scene, &dir.join("full.exr"), &dir.join("full.ckpt"), &["--spp", "8"]));
+    assert_eq!(std::fs::read(dir.join("c.exr")).unwrap(), std::fs::read(dir.join("full.exr")).unwrap());
+    assert_eq!(Checkpoint::read(&ckpt).unwrap().film, Checkpoint::read(&dir.join("full.ckpt")).unwrap().film);
+}

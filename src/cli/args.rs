@@ -129,8 +129,8 @@ pub struct RenderArgs {
 #[derive(Debug, Args, Clone, Default)]
 pub struct CheckpointArgs {
     /// Checkpoint file (default: for `render` the output's name with `.ckpt`, for
-    /// `resume` the checkpoint resumed). When given, the checkpoint is also written
-    /// when the render finishes.
+    /// `resume` the checkpoint resumed). `render` also writes it when the render
+    /// finishes if this is given; `resume` always does.
     #[arg(long, value_name = "PATH")]
     pub checkpoint: Option<PathBuf>,
     /// Write a checkpoint every SECONDS (between batches of passes).

@@ -154,12 +154,22 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     ckpt.target_end = end.max(done.end);
     ckpt.output = std::path::absolute(&output).map_err(|e| Error::io(&output, e))?;
     let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| path.clone());
-    // The checkpoint resumed is an input unless it is also where new checkpoints go.
+    // The checkpoint resumed is an input unless it is also where new checkpoints
+    // go: by default, or when `--checkpoint` names the same file.
     let resumed = [("checkpoint resumed", path.as_path())];
-    let extra: &[(&str, &Path)] = if args.checkpoint.checkpoint.is_some() { &resumed } else { &[] };
+    let extra: &[(&str, &Path)] = if same_file(&checkpoint_path, path) { &[] } else { &resumed };
     check_files(&ckpt.scene_path, &scene, extra, &output, &checkpoint_path, ckpt.film.spectral_sums().is_some())?;
-    let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, None);
+    let mut plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, None);
+    // A finished resume always leaves its checkpoint, holding every pass: without
+    // it, the passes rendered since the checkpoint lived only in the image, and a
+    // second `resume` of the same file started from the old pass count.
+    plan.final_checkpoint = true;
     session.run(&scene, ckpt, end, &plan)
+}
+
+/// Whether `a` and `b` name the same existing file (links followed), or are the same path.
+fn same_file(a: &Path, b: &Path) -> bool {
+    a == b || matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
 }
 
 pub fn merge_command(args: MergeArgs) -> Result<()> {
