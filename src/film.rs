@@ -24,7 +24,8 @@
 //!   nearest multiple of 2^-64 (≈ 5.4e-20): an absolute error far below
 //!   anything an f32 EXR or a 16-bit PNG can show.
 //! - Samples are clamped to `±`[`MAX_SAMPLE`] = 2^31 (≈ 2.1e9, a billion
-//!   times a bright light: only a bug produces it) and counted as invalid.
+//!   times a bright light: a light that bright, or a bug) and counted apart
+//!   from non-finite samples, which are dropped ([`Faults`]).
 //!   With that bound, even `u32::MAX` passes cannot overflow an `i128`
 //!   ((2^32 − 1) · 2^31 · 2^64 < 2^127), so every sum is exact.
 //!
@@ -100,6 +101,36 @@ pub(crate) struct Splat<S> {
     pub y: u32,
     /// The contribution, already divided by the light subpaths per pass.
     pub value: S,
+}
+
+/// Samples the film could not add as they were: non-finite ones are
+/// dropped (a bug: the renderer reports it), ones beyond ±[`MAX_SAMPLE`]
+/// clamped (a light brighter than the film's range: reported as such).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Faults {
+    /// NaN or infinite samples, dropped.
+    pub dropped: usize,
+    /// Samples beyond ±[`MAX_SAMPLE`], clamped.
+    pub clamped: usize,
+}
+
+impl std::ops::Add for Faults {
+    type Output = Faults;
+    fn add(self, o: Faults) -> Faults {
+        Faults { dropped: self.dropped + o.dropped, clamped: self.clamped + o.clamped }
+    }
+}
+
+impl std::ops::AddAssign for Faults {
+    fn add_assign(&mut self, o: Faults) {
+        *self = *self + o;
+    }
+}
+
+impl std::iter::Sum for Faults {
+    fn sum<I: Iterator<Item = Faults>>(iter: I) -> Faults {
+        iter.fold(Faults::default(), |a, b| a + b)
+    }
 }
 
 /// A rectangle of pixels `[x0, x1) × [y0, y1)`: what the film adds a buffer of
@@ -315,13 +346,12 @@ impl Film {
     }
 
     /// Adds one sample per pixel of `tile` (row-major within the tile).
-    /// Returns the number of invalid samples: non-finite ones are dropped,
-    /// ones beyond ±[`MAX_SAMPLE`] are clamped. Both are counted and reported
-    /// by the renderer: they are bugs, never expected. (The renderer adds
+    /// Returns the samples it could not add as they were ([`Faults`]):
+    /// non-finite ones are dropped, ones beyond ±[`MAX_SAMPLE`] clamped. (The renderer adds
     /// whole batches with [`Film::add_tiles_parallel`]; this is the tests'
     /// tile-by-tile reference.)
     #[cfg(test)]
-    pub(crate) fn add_tile<S: FilmSample>(&mut self, tile: &Tile, samples: &[S]) -> usize {
+    pub(crate) fn add_tile<S: FilmSample>(&mut self, tile: &Tile, samples: &[S]) -> Faults {
         add_tile_to_rows(&mut self.sums, self.spectral.as_deref_mut(), self.width, 0, tile, samples)
     }
 
@@ -337,14 +367,14 @@ impl Film {
     /// serial time (adding them after the parallel loop, on one thread, was 3% of
     /// a light-tracing render: a 1.94x ceiling on two threads).
     /// The caller records the passes with `end_pass`.
-    /// Returns the invalid samples and splats.
+    /// Returns the samples and splats it dropped or clamped.
     pub(crate) fn add_tiles_parallel<S: FilmSample>(
         &mut self,
         tiles: &[Tile],
         samples: &[Vec<S>],
         splats: &[Vec<Splat<S>>],
         tile_size: u32,
-    ) -> usize {
+    ) -> Faults {
         use rayon::prelude::*;
         assert!(!tiles.is_empty() && samples.len().is_multiple_of(tiles.len()), "samples must hold whole passes");
         let width = self.width;
@@ -361,10 +391,10 @@ impl Film {
                     band_tiles
                         .clone()
                         .map(|k| add_tile_to_rows(rows, spec.as_deref_mut(), width, first_row, &tiles[k], &pass[k]))
-                        .sum::<usize>()
+                        .sum::<Faults>()
                 })
-                .sum::<usize>();
-            let mut splatted = 0;
+                .sum::<Faults>();
+            let mut splatted = Faults::default();
             for list in splats {
                 let b = band as u32;
                 let mine =
@@ -395,8 +425,8 @@ impl Film {
     /// clamped and counted (the return value). (The renderer adds splats with the
     /// samples in [`Film::add_tiles_parallel`]; this is the tests' reference.)
     #[cfg(test)]
-    pub(crate) fn add_splats<S: FilmSample>(&mut self, splats: &[Splat<S>]) -> usize {
-        let mut bad = 0;
+    pub(crate) fn add_splats<S: FilmSample>(&mut self, splats: &[Splat<S>]) -> Faults {
+        let mut bad = Faults::default();
         for s in splats {
             if s.x >= self.width || s.y >= self.height {
                 continue;
@@ -487,9 +517,9 @@ fn add_tile_to_rows<S: FilmSample>(
     first_row: u32,
     tile: &Tile,
     samples: &[S],
-) -> usize {
+) -> Faults {
     debug_assert_eq!(samples.len(), tile.len());
-    let mut bad = 0;
+    let mut bad = Faults::default();
     let mut k = 0;
     for y in tile.y0..tile.y1 {
         let row = (y - first_row) as usize * width as usize;
@@ -504,13 +534,13 @@ fn add_tile_to_rows<S: FilmSample>(
 
 /// Adds one sample to a pixel's sums (and its spectral sums, if the film has
 /// them). A non-finite sample is dropped, one beyond ±[`MAX_SAMPLE`] clamped;
-/// returns 1 for either (the renderer reports them), else 0.
+/// returns which (the renderer reports them).
 #[inline]
-fn add_sample<S: FilmSample>(sum: &mut [i128; 3], spectral: Option<&mut [i128; N_BINS]>, sample: &S) -> usize {
+fn add_sample<S: FilmSample>(sum: &mut [i128; 3], spectral: Option<&mut [i128; N_BINS]>, sample: &S) -> Faults {
     let s = sample.xyz();
     let bins = sample.bins();
     if !(s.x.is_finite() && s.y.is_finite() && s.z.is_finite()) || bins.is_some_and(|b| b.has_nan_or_inf()) {
-        return 1;
+        return Faults { dropped: 1, clamped: 0 };
     }
     if let (Some(spec), Some(b)) = (spectral, bins) {
         for (acc, &v) in spec.iter_mut().zip(&b.0) {
@@ -520,7 +550,7 @@ fn add_sample<S: FilmSample>(sum: &mut [i128; 3], spectral: Option<&mut [i128; N
     sum[0] += to_fixed(s.x);
     sum[1] += to_fixed(s.y);
     sum[2] += to_fixed(s.z);
-    usize::from(s.x.abs().max(s.y.abs()).max(s.z.abs()) > MAX_SAMPLE)
+    Faults { dropped: 0, clamped: usize::from(s.x.abs().max(s.y.abs()).max(s.z.abs()) > MAX_SAMPLE) }
 }
 
 #[cfg(test)]
@@ -533,7 +563,7 @@ mod tests {
         let mut f = Film::new(2, 1);
         let t = Tile { x0: 0, y0: 0, x1: 2, y1: 1 };
         let bad = f.add_tile(&t, &[Xyz::new(f32::NAN, 0.0, 0.0), Xyz::new(1.0, 2.0, 3.0)]);
-        assert_eq!(bad, 1);
+        assert_eq!(bad, Faults { dropped: 1, clamped: 0 });
         assert_eq!(f.sums, vec![[0; 3], [to_fixed(1.0), to_fixed(2.0), to_fixed(3.0)]]);
     }
 
@@ -546,7 +576,7 @@ mod tests {
         assert_eq!(to_fixed(1e-25), 0);
         let mut f = Film::new(1, 1);
         let t = Tile { x0: 0, y0: 0, x1: 1, y1: 1 };
-        assert_eq!(f.add_tile(&t, &[Xyz::new(1e30, 0.0, 0.0)]), 1);
+        assert_eq!(f.add_tile(&t, &[Xyz::new(1e30, 0.0, 0.0)]), Faults { dropped: 0, clamped: 1 });
     }
 
     /// Batches of passes and splats added band by band in parallel give the sums of
@@ -570,7 +600,7 @@ mod tests {
             }
         }
         let mut serial = Film::new(w, h);
-        let mut invalid = 0;
+        let mut invalid = Faults::default();
         for (j, s) in samples.iter().enumerate() {
             invalid += serial.add_tile(&ts[j % ts.len()], s);
         }
@@ -593,7 +623,7 @@ mod tests {
         splats.iter_mut().for_each(|l| l.sort_by_key(|s| s.y / size));
         let mut parallel = Film::new(w, h);
         assert_eq!(parallel.add_tiles_parallel(&ts, &samples, &splats, size), invalid);
-        assert!(invalid >= 2);
+        assert!(invalid.dropped + invalid.clamped >= 2);
         assert_eq!(parallel.sums(), serial.sums());
     }
 

@@ -102,6 +102,9 @@ pub struct RenderStats {
     pub passes: u32,
     /// Samples that were NaN or infinite and were dropped (always a bug).
     pub invalid_samples: u64,
+    /// Samples beyond the film's range ±`film::MAX_SAMPLE` that were clamped
+    /// (a light brighter than the range; not a bug, but the image is darker there).
+    pub clamped_samples: u64,
     /// Wall time spent rendering.
     pub elapsed: Duration,
     /// True when the stop flag ended the render before its last pass.
@@ -204,7 +207,9 @@ impl Run<'_, '_> {
             if whole > 0 {
                 if !tiles.is_empty() {
                     // Integer sums: the order in which samples and splats are added does not matter.
-                    stats.invalid_samples += film.add_tiles_parallel(&tiles, &samples, &splats, TILE_SIZE) as u64;
+                    let faults = film.add_tiles_parallel(&tiles, &samples, &splats, TILE_SIZE);
+                    stats.invalid_samples += faults.dropped as u64;
+                    stats.clamped_samples += faults.clamped as u64;
                 }
                 for _ in 0..whole {
                     film.end_pass();

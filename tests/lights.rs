@@ -225,3 +225,38 @@ fn a_light_just_inside_a_closed_box_lights_nothing_outside() {
         }
     }
 }
+
+/// Issue 34 item 11: a spot light far brighter than the film's range gets one
+/// warning before rendering that names what is clamped (what it lights: a
+/// camera never sees a spot light), and at the end a count of clamped samples
+/// that does not call them a bug. NaN or infinite samples would still be a bug
+/// to report; there are none here.
+#[test]
+fn a_light_beyond_the_film_s_range_is_reported_as_clamped_not_as_a_bug() {
+    let dir = crate::common::temp_dir("bright-spot");
+    let text = scene(DOWN, "").replace(
+        "],\n)",
+        "],\n    lights: [ Spot(position: (0, 1, 0), look_at: (0, 0, 0), cone_deg: 30, falloff_deg: 5, intensity: Scaled(1e12, D65)) ],\n)",
+    );
+    let path = dir.join("bright.ron");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("bright.png");
+    let o = crate::common::rust_v(&[
+        "render",
+        path.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("samples it lights brightly are clamped"), "{err}");
+    assert!(!err.contains("see it directly"), "{err}");
+    assert!(err.contains("clamped: the image is darker there"), "{err}");
+    assert!(!err.contains("bug"), "{err}");
+}

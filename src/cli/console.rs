@@ -58,10 +58,18 @@ pub fn out(text: &str) -> Result<()> {
 
 /// Prints the warnings and the summary of a finished render.
 pub fn report(scene: &Scene, stats: &RenderStats, output: &Path, quiet: bool) {
+    if stats.clamped_samples > 0 {
+        warn(format_args!(
+            "{} {} brighter than the film's range ±2^31 and clamped: the image is darker there than the scene",
+            stats.clamped_samples,
+            if stats.clamped_samples == 1 { "sample was" } else { "samples were" }
+        ));
+    }
     if stats.invalid_samples > 0 {
         warn(format_args!(
-            "{} samples were NaN, infinite (dropped) or beyond ±2^31 (clamped): a bug, please report it",
-            stats.invalid_samples
+            "{} {} NaN or infinite and dropped: a bug, please report it with the scene",
+            stats.invalid_samples,
+            if stats.invalid_samples == 1 { "sample was" } else { "samples were" }
         ));
     }
     if !quiet {

@@ -269,8 +269,11 @@ fn check_files(
     for (i, light) in scene.lights.iter().enumerate() {
         let peak = light.spectrum().max_value();
         if peak > MAX_SAMPLE {
+            // A point, spot, distant or beam light is never seen by the camera: what
+            // may be clamped is what it lights.
+            let what = if light.is_delta() { "samples it lights brightly" } else { "pixels that see it directly" };
             warn(format_args!(
-                "light {i} emits up to {peak:e}, beyond the film's sample range ±{MAX_SAMPLE:e}: pixels that see it directly are clamped"
+                "light {i} emits up to {peak:e}, beyond the film's sample range ±{MAX_SAMPLE:e}: {what} are clamped"
             ));
         }
     }
