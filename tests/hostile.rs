@@ -570,3 +570,23 @@ fn a_spectrum_line_of_400k_fields_is_refused_fast_and_briefly() {
     assert!(e.len() < 400, "the error quotes too much: {} bytes", e.len());
     assert!(took < Duration::from_secs(3), "took {took:?}");
 }
+
+/// Out-of-range values in a spectrum file name the data file, its line and
+/// column, and the range that applies: [0, 1] for a reflectance (before:
+/// only the scene's field and "up to 1e15"), non-negative for an emission.
+#[test]
+fn out_of_range_spectrum_file_values_name_the_file_and_row() {
+    let d = temp_dir("hostile-csv-range");
+    std::fs::write(d.join("refl.csv"), "nm,r\n400,0.5\n500, 1.5\n600,0.5\n").unwrap();
+    let scene = scene_in(&d, &SCENE.replace("Constant(0.5)", "File(\"refl.csv\")"));
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]), 1);
+    assert!(e.contains("refl.csv:3:6") && e.contains("[0, 1]") && e.contains("1.5"), "{e}");
+    assert!(e.contains("materials.\"white\".reflectance"), "{e}");
+    assert!(!e.contains("1e15"), "{e}");
+    std::fs::write(d.join("led.csv"), "400,1\n500,2\n600,-3\n").unwrap();
+    let lit = SCENE.replace("intensity: Constant(10)", "intensity: File(\"led.csv\")");
+    let scene = scene_in(&d, &lit);
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]), 1);
+    assert!(e.contains("led.csv:3:5") && e.contains("-3") && e.contains("non-negative"), "{e}");
+    assert!(e.contains("lights[0].intensity"), "{e}");
+}
