@@ -590,3 +590,29 @@ fn out_of_range_spectrum_file_values_name_the_file_and_row() {
     assert!(e.contains("led.csv:3:5") && e.contains("-3") && e.contains("non-negative"), "{e}");
     assert!(e.contains("lights[0].intensity"), "{e}");
 }
+
+// ---------------------------------------------------------------------------
+// 13. A transform that collapses a mesh is named (issue 34 item 8).
+
+/// `translate: (1e15, 0, 0)` puts a unit triangle where f32 spacing is 2^26:
+/// its vertices collapse. The error names the translation (the mesh's own,
+/// or the object's `transform:`), not the mesh (before: "no valid
+/// triangles (1 given, 1 of zero area)" on `objects[0].shape.path`).
+#[test]
+fn a_translation_that_collapses_a_mesh_is_named() {
+    let d = temp_dir("hostile-collapse");
+    std::fs::write(d.join("tri.obj"), TRI_OBJ).unwrap();
+    for (mesh, field) in [
+        ("Mesh(path: \"tri.obj\", translate: (1e15, 0, 0))", "objects[0].shape.translate"),
+        ("Mesh(path: \"tri.obj\"), transform: (translate: (1e15, 0, 0))", "objects[0].transform.translate"),
+    ] {
+        let scene = scene_in(&d, &MESH_SCENE.replace("Mesh(path: \"tri.obj\")", mesh));
+        let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]), 1);
+        assert!(e.contains(field) && e.contains("collapses"), "{e}");
+    }
+    // A mesh degenerate before any transform still blames the mesh.
+    std::fs::write(d.join("tri.obj"), "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
+    let scene = scene_in(&d, MESH_SCENE);
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]), 1);
+    assert!(e.contains("no valid triangles") && e.contains("objects[0].shape.path"), "{e}");
+}
