@@ -616,3 +616,28 @@ fn a_translation_that_collapses_a_mesh_is_named() {
     let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]), 1);
     assert!(e.contains("no valid triangles") && e.contains("objects[0].shape.path"), "{e}");
 }
+
+// ---------------------------------------------------------------------------
+// 14. Settings that do nothing are warned about (issue 34 items 10, 12).
+
+fn warnings(o: &Output) -> Vec<String> {
+    stderr(o).lines().filter(|l| l.starts_with("rust-v: warning:")).map(str::to_string).collect()
+}
+
+/// `priority` on a Lambertian or an emitter does nothing: one warning line
+/// naming `objects[i].priority` each (before: accepted silently); on a
+/// dielectric, none.
+#[test]
+fn priority_on_a_non_dielectric_is_warned_about() {
+    let d = temp_dir("hostile-priority");
+    let text = SCENE
+        .replace("material: \"white\") ]", "material: \"white\", priority: 2), (shape: Sphere(center: (0, 2, 0), radius: 0.1), emission: Constant(1), priority: 1), (shape: Sphere(center: (0, -2, 0), radius: 0.1), material: \"glass\", priority: 3) ]")
+        .replace("materials: {", "materials: { \"glass\": Dielectric(ior: Constant(1.5)),");
+    let scene = scene_in(&d, &text);
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let w = warnings(&o);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(w[0].contains("objects[0].priority") && w[1].contains("objects[1].priority"), "{w:?}");
+    assert!(!w.iter().any(|l| l.contains("objects[2]")), "{w:?}");
+}

@@ -256,6 +256,7 @@ fn check_files(
         }
     }
     check_memory(scene.settings.width, scene.settings.height, spectral)?;
+    warn_no_effect(scene);
     for (i, light) in scene.lights.iter().enumerate() {
         let peak = light.spectrum().max_value();
         if peak > MAX_SAMPLE {
@@ -265,6 +266,20 @@ fn check_files(
         }
     }
     Ok(())
+}
+
+/// Warns about what the scene asks for that cannot happen: a `priority` on an
+/// object that is not a dielectric (only dielectric volumes nest).
+fn warn_no_effect(scene: &Scene) {
+    for (i, o) in scene.objects.iter().enumerate() {
+        let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
+        if o.priority != 0 && !dielectric {
+            warn(format_args!(
+                "objects[{i}].priority: {} has no effect: the object is not a dielectric, and only dielectric volumes nest by priority",
+                o.priority
+            ));
+        }
+    }
 }
 
 /// Refuses a film larger than the memory this machine has available (Linux:
