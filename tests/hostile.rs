@@ -641,3 +641,19 @@ fn priority_on_a_non_dielectric_is_warned_about() {
     assert!(w[0].contains("objects[0].priority") && w[1].contains("objects[1].priority"), "{w:?}");
     assert!(!w.iter().any(|l| l.contains("objects[2]")), "{w:?}");
 }
+
+/// A scene without any light renders black: one warning line before the
+/// render (before: silent, exit 0); a scene with a light gets none.
+#[test]
+fn a_scene_without_light_is_warned_about() {
+    let d = temp_dir("hostile-dark");
+    let dark = SCENE.replace("lights: [ Point(position: (0, 3, 3), intensity: Constant(10)) ],", "");
+    let scene = scene_in(&d, &dark);
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let w = warnings(&o);
+    assert!(w.len() == 1 && w[0].contains("no light"), "{w:?}");
+    let scene = scene_in(&d, SCENE);
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]);
+    assert!(warnings(&o).is_empty(), "{}", stderr(&o));
+}

@@ -269,7 +269,8 @@ fn check_files(
 }
 
 /// Warns about what the scene asks for that cannot happen: a `priority` on an
-/// object that is not a dielectric (only dielectric volumes nest).
+/// object that is not a dielectric (only dielectric volumes nest), and a
+/// scene without any light (the image is black).
 fn warn_no_effect(scene: &Scene) {
     for (i, o) in scene.objects.iter().enumerate() {
         let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
@@ -279,6 +280,11 @@ fn warn_no_effect(scene: &Scene) {
                 o.priority
             ));
         }
+    }
+    if scene.lights.is_empty() {
+        warn(format_args!(
+            "the scene has no light (no `lights` and no object with an `emission`): the image will be black"
+        ));
     }
 }
 
