@@ -448,21 +448,41 @@ fn resume_and_merge_refuse_changed_meshes() {
         ck
     };
     let a = part("a", "0..1");
+    // Past the file system's timestamp granularity, so the change is seen as after the checkpoint.
+    std::thread::sleep(Duration::from_millis(50));
     std::fs::write(&mesh, TRI_OBJ.replace("v 0 1 0", "v 0 0.9 0")).unwrap();
     let b = part("b", "1..2");
+    // The changed input is named (issue 34 item 16): the mesh, modified after the checkpoint.
     let e = one_error(&run(&["resume", s(&a), "-q"]), 1);
     assert!(e.contains("changed") && e.contains("mesh"), "{e}");
+    assert!(e.contains(&format!("{} modified after it", s(&mesh))), "{e}");
     let o = run(&["resume", s(&a), "-q", "--force"]);
     assert!(o.status.success() && stderr(&o).contains("warning"), "{}", stderr(&o));
+    assert!(stderr(&o).contains(&format!("{} modified after it", s(&mesh))), "{}", stderr(&o));
     let e = one_error(&run(&["merge", s(&a), s(&b), "-o", s(&d.join("m.png"))]), 1);
     assert!(e.contains("different scene"), "{e}");
     // A spectrum file is an input too.
     std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.8\n").unwrap();
     std::fs::write(&scene, SCENE.replace("Constant(0.5)", "File(\"refl.csv\")")).unwrap();
     let c = part("c", "0..1");
+    std::thread::sleep(Duration::from_millis(50));
     std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.7\n").unwrap();
     let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
-    assert!(e.contains("changed"), "{e}");
+    assert!(e.contains("changed") && e.contains("refl.csv modified after it"), "{e}");
+    // When no input is newer than the checkpoint, every input is named as possibly changed
+    // (the checkpoint keeps one hash over them all).
+    let old = std::time::SystemTime::UNIX_EPOCH + Duration::from_secs(1_000_000_000);
+    for f in [d.join("refl.csv"), scene.clone()] {
+        std::fs::File::options().write(true).open(&f).unwrap().set_modified(old).unwrap();
+    }
+    let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
+    assert!(e.contains("refl.csv") && e.contains("which is not known"), "{e}");
+    // A scene that reads no other file: the scene file itself changed.
+    std::fs::write(&scene, SCENE).unwrap();
+    let plain = part("plain", "0..1");
+    std::fs::write(&scene, SCENE.replace("Constant(0.5)", "Constant(0.6)")).unwrap();
+    let e = one_error(&run(&["resume", s(&plain), "-q"]), 1);
+    assert!(e.contains(&format!("the scene file {} changed", s(&scene))), "{e}");
 }
 
 // ---------------------------------------------------------------------------

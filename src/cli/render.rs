@@ -120,18 +120,15 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
     if scene.content_hash != ckpt.content_hash && args.force {
-        warn(format_args!(
-            "{} or a file it reads changed since the checkpoint was written; resuming anyway (--force)",
-            ckpt.scene_path.display()
-        ));
+        warn(format_args!("{}; resuming anyway (--force)", changed_inputs(path, &ckpt.scene_path, &scene.inputs)));
         ckpt.content_hash = scene.content_hash;
     }
     if scene.content_hash != ckpt.content_hash {
         return Err(Error::checkpoint(
             path,
             format!(
-                "the scene {} or a file it reads (mesh, data) changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
-                ckpt.scene_path.display(),
+                "{} (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
+                changed_inputs(path, &ckpt.scene_path, &scene.inputs),
                 scene.content_hash,
                 ckpt.content_hash
             ),
@@ -160,6 +157,38 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     check_files(&ckpt.scene_path, &scene, extra, &output, &checkpoint_path, ckpt.film.spectral_sums().is_some())?;
     let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, None);
     session.run(&scene, ckpt, end, &plan)
+}
+
+/// Says which inputs of a resumed scene changed, as far as can be told. The
+/// checkpoint stores one hash over the scene file and every file it reads
+/// (meshes, data), not one per file, so: a scene that reads no other file
+/// changed itself; otherwise the inputs modified after the checkpoint file
+/// was written are named; when none was (or the times cannot be read), every
+/// input is named as possibly changed.
+fn changed_inputs(checkpoint: &Path, scene: &Path, inputs: &[PathBuf]) -> String {
+    if inputs.is_empty() {
+        return format!("the scene file {} changed since the checkpoint was written", scene.display());
+    }
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let all: Vec<&Path> = std::iter::once(scene).chain(inputs.iter().map(|p| p.as_path())).collect();
+    let newer: Vec<&Path> = match modified(checkpoint) {
+        Some(written) => all.iter().copied().filter(|p| modified(p).is_some_and(|t| t > written)).collect(),
+        None => Vec::new(),
+    };
+    let names = |ps: &[&Path]| ps.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    if newer.is_empty() {
+        format!(
+            "the scene {} or a file it reads (mesh, data: {}) changed since the checkpoint was written; none was modified after it, and the checkpoint keeps one hash over them all, so which is not known",
+            scene.display(),
+            names(&all[1..])
+        )
+    } else {
+        format!(
+            "the scene {} or a file it reads (mesh, data) changed since the checkpoint was written: {} modified after it",
+            scene.display(),
+            names(&newer)
+        )
+    }
 }
 
 pub fn merge_command(args: MergeArgs) -> Result<()> {
