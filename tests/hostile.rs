@@ -677,3 +677,27 @@ fn a_scene_without_light_is_warned_about() {
     let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]);
     assert!(warnings(&o).is_empty(), "{}", stderr(&o));
 }
+
+// ---------------------------------------------------------------------------
+// 15. Paths in messages are escaped; counts agree with their nouns (issue 34 items 7, 15).
+
+/// A path with a newline in it (a directory named `a\nb`) keeps every error
+/// and warning on one line: paths print escaped and quoted when they hold a
+/// control character, also those read back from a checkpoint (before: the
+/// error split over two lines, the second not in rust-v's style).
+#[test]
+fn a_path_with_a_newline_keeps_messages_on_one_line() {
+    let d = temp_dir("hostile-newline").join("a\nb");
+    std::fs::create_dir_all(&d).unwrap();
+    let scene = scene_in(&d, &SCENE.replace("material: \"white\"", "material: \"grey\""));
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png"))]), 1);
+    assert!(e.contains("a\\nb") && e.contains("unknown material"), "{e}");
+    // The scene path read back from a checkpoint.
+    let scene = scene_in(&d, SCENE);
+    let ck = d.join("o.ckpt");
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png")), "--checkpoint", s(&ck)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(&scene).unwrap();
+    let e = one_error(&run(&["resume", s(&ck), "-q", "--spp", "4"]), 1);
+    assert!(e.contains("a\\nb") && e.contains("cannot load its scene"), "{e}");
+}

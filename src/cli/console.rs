@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use rust_v::error::{Error, Result};
+use rust_v::error::{Error, Result, show_path};
 use rust_v::render::{Progress, RenderStats};
 use rust_v::scene::Scene;
 
@@ -68,7 +68,7 @@ pub fn report(scene: &Scene, stats: &RenderStats, output: &Path, quiet: bool) {
         let samples = stats.passes as f64 * scene.settings.width as f64 * scene.settings.height as f64;
         say(format_args!(
             "wrote {} ({} passes in {:.2} s, {:.3} Msamples/s)",
-            output.display(),
+            show_path(&output),
             stats.passes,
             stats.elapsed.as_secs_f64(),
             samples / stats.elapsed.as_secs_f64().max(1e-9) / 1e6

@@ -34,7 +34,7 @@ use std::time::{Duration, Instant};
 use signal_hook::SigId;
 
 use rust_v::checkpoint::{Checkpoint, snapshot_path};
-use rust_v::error::{Error, Result};
+use rust_v::error::{Error, Result, show_path};
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
 use rust_v::scene::Scene;
@@ -168,7 +168,7 @@ impl Session {
             if let Ok(msg) = snapshot {
                 view.note(format_args!("stopped by a signal: {msg}"));
             }
-            view.note(format_args!("continue with: rust-v resume {}", saved.display()));
+            view.note(format_args!("continue with: rust-v resume {}", show_path(&saved)));
         }
         if !stats.interrupted {
             if let Err(e) = ckpt.film.write(&plan.output) {
@@ -176,13 +176,13 @@ impl Session {
                 return Err(Error::Settings(format!(
                     "{e}; the render's {} passes are saved in {}: continue with `rust-v resume {} -o OTHER.png`",
                     ckpt.film.passes(),
-                    saved.display(),
-                    saved.display()
+                    show_path(&saved),
+                    show_path(&saved)
                 )));
             }
             if plan.final_checkpoint && !stopped {
                 let saved = save_work(&ckpt, plan, None)?;
-                view.note(format_args!("wrote checkpoint {}", saved.display()));
+                view.note(format_args!("wrote checkpoint {}", show_path(&saved)));
             }
             report(scene, &stats, &plan.output, plan.quiet);
         }
@@ -219,7 +219,7 @@ fn save_work(ckpt: &Checkpoint, plan: &SessionPlan, cause: Option<&Error>) -> Re
     let fallback = fallback_path(&plan.checkpoint_path);
     match ckpt.write_with(&ckpt.film, &fallback) {
         Ok(_) => {
-            super::console::warn(format_args!("{first}; the checkpoint went to {} instead", fallback.display()));
+            super::console::warn(format_args!("{first}; the checkpoint went to {} instead", show_path(&fallback)));
             Ok(fallback)
         }
         Err(second) => {
@@ -242,7 +242,7 @@ fn fallback_path(checkpoint: &Path) -> PathBuf {
 fn write_snapshot(film: &Film, plan: &SessionPlan) -> Result<String> {
     let path = snapshot_path(&plan.output, film.passes());
     film.write(&path)?;
-    Ok(format!("wrote snapshot {} ({} passes)", path.display(), film.passes()))
+    Ok(format!("wrote snapshot {} ({} passes)", show_path(&path), film.passes()))
 }
 
 fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<String> {
@@ -251,7 +251,7 @@ fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<Strin
     let r = film.pass_range();
     Ok(format!(
         "wrote checkpoint {} (passes {}..{}, {:.2} MB in {:.0} ms)",
-        path.display(),
+        show_path(&path),
         r.start,
         r.end,
         size as f64 / 1e6,

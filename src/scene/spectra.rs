@@ -9,7 +9,7 @@ use super::check::{Check, MAX_MAGNITUDE};
 use super::desc::{IorDesc, SpectrumDesc};
 use crate::bxdf::{Ior, NAMED_GLASSES, named_glass};
 use crate::color::{self, N_BINS, Spectrum};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, show_path};
 use crate::io::parse_spectrum_rows;
 
 /// What a spectrum describes: it decides what `Rgb(r, g, b)` means.
@@ -46,7 +46,7 @@ impl Check<'_> {
         let (path, bytes) = self.read_input(field, rel)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let at = e.utf8_error().valid_up_to();
-            self.err(field, format!("\"{}\": byte {at} is not UTF-8; expected a UTF-8 text file", path.display()))
+            self.err(field, format!("{}: byte {at} is not UTF-8; expected a UTF-8 text file", show_path(&path)))
         })?;
         Ok((path, text))
     }
