@@ -701,3 +701,24 @@ fn a_path_with_a_newline_keeps_messages_on_one_line() {
     let e = one_error(&run(&["resume", s(&ck), "-q", "--spp", "4"]), 1);
     assert!(e.contains("a\\nb") && e.contains("cannot load its scene"), "{e}");
 }
+
+/// Counts of one take the singular: "1 object, 1 light", "1 pass",
+/// "merged 1 checkpoint" (before: "1 objects, 1 lights", "1 passes",
+/// "merged 1 checkpoints").
+#[test]
+fn counts_of_one_are_singular() {
+    let d = temp_dir("hostile-plural");
+    let scene = scene_in(&d, &SCENE.replace("spp: 2", "spp: 1"));
+    let ck = d.join("o.ckpt");
+    let o = run(&["render", s(&scene), "-o", s(&d.join("o.png")), "--checkpoint", s(&ck)]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("(1 object, 1 light,") && err.contains("(1 pass in"), "{err}");
+    let o = run(&["merge", s(&ck), "-o", s(&d.join("m.png"))]);
+    let err = stderr(&o);
+    assert!(o.status.success() && err.contains("merged 1 checkpoint ("), "{err}");
+    let scene = scene_in(&d, &SCENE.replace("spp: 2", "spp: 2, max_bounces: 1"));
+    let o = run(&["render", s(&scene), "-o", s(&d.join("o.png"))]);
+    let err = stderr(&o);
+    assert!(err.contains("1 bounce,") && err.contains("(2 passes in"), "{err}");
+}

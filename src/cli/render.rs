@@ -18,7 +18,7 @@ use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, paren
 use rust_v::scene::{Scene, load_scene};
 
 use super::args::{MergeArgs, RenderArgs, ResumeArgs};
-use super::console::{say, warn};
+use super::console::{count, say, warn};
 use super::session::{Session, SessionPlan};
 
 fn default_output(scene: &Path) -> PathBuf {
@@ -56,15 +56,15 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     }
     if !args.run.quiet {
         say(format_args!(
-            "{} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}",
+            "{} ({}, {}, loaded in {:.2} s): {}x{}, {} spp, {}, seed {}",
             show_path(&args.scene),
-            scene.object_count(),
-            scene.lights.len(),
+            count(scene.object_count() as u64, "object"),
+            count(scene.lights.len() as u64, "light"),
             load_time.as_secs_f64(),
             s.width,
             s.height,
             s.spp,
-            s.max_bounces,
+            count(s.max_bounces, "bounce"),
             s.seed,
         ));
         say(format_args!("{}", rust_v::integrator::describe(&scene)));
@@ -218,8 +218,8 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     if !args.quiet {
         let r = merged.passes();
         say(format_args!(
-            "merged {} checkpoints (passes {}..{}) into {}",
-            args.parts.len(),
+            "merged {} (passes {}..{}) into {}",
+            count(args.parts.len() as u64, "checkpoint"),
             r.start,
             r.end,
             show_path(&args.output)

@@ -40,7 +40,7 @@ use rust_v::render::{Limits, render};
 use rust_v::scene::Scene;
 
 use super::args::{CheckpointArgs, RunArgs};
-use super::console::{ProgressView, report, thread_pool};
+use super::console::{ProgressView, count, report, thread_pool};
 
 /// Where a session writes and how it runs.
 pub struct SessionPlan {
@@ -174,8 +174,9 @@ impl Session {
             if let Err(e) = ckpt.film.write(&plan.output) {
                 let saved = save_work(&ckpt, plan, Some(&e))?;
                 return Err(Error::Settings(format!(
-                    "{e}; the render's {} passes are saved in {}: continue with `rust-v resume {} -o OTHER.png`",
-                    ckpt.film.passes(),
+                    "{e}; the render's {} {} saved in {}: continue with `rust-v resume {} -o OTHER.png`",
+                    count(ckpt.film.passes(), "pass"),
+                    if ckpt.film.passes() == 1 { "is" } else { "are" },
                     show_path(&saved),
                     show_path(&saved)
                 )));
@@ -225,8 +226,8 @@ fn save_work(ckpt: &Checkpoint, plan: &SessionPlan, cause: Option<&Error>) -> Re
         Err(second) => {
             let cause = cause.map(|c| format!("{c}; ")).unwrap_or_default();
             Err(Error::Settings(format!(
-                "{cause}{first}; {second}: the render's {} passes could not be saved anywhere",
-                ckpt.film.passes()
+                "{cause}{first}; {second}: the render's {} could not be saved anywhere",
+                count(ckpt.film.passes(), "pass")
             )))
         }
     }
@@ -242,7 +243,7 @@ fn fallback_path(checkpoint: &Path) -> PathBuf {
 fn write_snapshot(film: &Film, plan: &SessionPlan) -> Result<String> {
     let path = snapshot_path(&plan.output, film.passes());
     film.write(&path)?;
-    Ok(format!("wrote snapshot {} ({} passes)", show_path(&path), film.passes()))
+    Ok(format!("wrote snapshot {} ({})", show_path(&path), count(film.passes(), "pass")))
 }
 
 fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<String> {
