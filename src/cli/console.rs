@@ -83,7 +83,7 @@ pub fn report(scene: &Scene, stats: &RenderStats, output: &Path, quiet: bool) {
         let samples = stats.passes as f64 * scene.settings.width as f64 * scene.settings.height as f64;
         say(format_args!(
             "wrote {} ({} in {:.2} s, {:.3} Msamples/s)",
-            show_path(&output),
+            show_path(output),
             count(stats.passes, "pass"),
             stats.elapsed.as_secs_f64(),
             samples / stats.elapsed.as_secs_f64().max(1e-9) / 1e6

@@ -100,7 +100,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     if ckpt.crate_version != env!("CARGO_PKG_VERSION") {
         warn(format_args!(
             "{} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
-            show_path(&path),
+            show_path(path),
             ckpt.crate_version,
             env!("CARGO_PKG_VERSION")
         ));
@@ -141,7 +141,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     if !args.run.quiet {
         say(format_args!(
             "resuming {} ({}): passes {}..{} done, rendering to pass {}",
-            show_path(&path),
+            show_path(path),
             show_path(&ckpt.scene_path),
             done.start,
             done.end,
@@ -234,7 +234,7 @@ fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
         return Err(Error::Settings(format!(
             "--color-space {} needs an .exr output; {} is a PNG, always sRGB",
             space.name(),
-            show_path(&output)
+            show_path(output)
         )));
     }
     Ok(())
@@ -243,7 +243,7 @@ fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
 fn check_output_extension(output: &Path) -> Result<()> {
     match output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()) {
         Some(e) if e == "png" || e == "exr" => Ok(()),
-        _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", show_path(&output)))),
+        _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", show_path(output)))),
     }
 }
 
@@ -271,7 +271,7 @@ fn check_files(
     if stem.len() + "-4294967295.png".len() > NAME_MAX {
         return Err(Error::Settings(format!(
             "image {}: its snapshots (`{stem}-00128.png`) would have names longer than {NAME_MAX} bytes; choose a shorter name",
-            show_path(&output)
+            show_path(output)
         )));
     }
     let dir = std::fs::canonicalize(parent_dir(output)).ok();
@@ -280,8 +280,8 @@ fn check_files(
         if same_dir && path.file_name().is_some_and(|n| is_snapshot_name(n, &stem)) {
             return Err(Error::Settings(format!(
                 "{role} {} has the name of a snapshot of {}: a snapshot would overwrite it",
-                show_path(&path),
-                show_path(&output)
+                show_path(path),
+                show_path(output)
             )));
         }
     }

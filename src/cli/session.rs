@@ -252,7 +252,7 @@ fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<Strin
     let r = film.pass_range();
     Ok(format!(
         "wrote checkpoint {} (passes {}..{}, {:.2} MB in {:.0} ms)",
-        show_path(&path),
+        show_path(path),
         r.start,
         r.end,
         size as f64 / 1e6,

@@ -24,10 +24,10 @@ fn compare_files(a: &Path, b: &Path) -> Result<(Image, Image, Metrics)> {
     if (ia.width, ia.height) != (ib.width, ib.height) {
         return Err(Error::Settings(format!(
             "images differ in size: {} is {}x{}, {} is {}x{}",
-            show_path(&a),
+            show_path(a),
             ia.width,
             ia.height,
-            show_path(&b),
+            show_path(b),
             ib.width,
             ib.height
         )));
@@ -282,7 +282,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
     }
     if !args.run.quiet {
         for p in &written {
-            say(format_args!("wrote {}", show_path(&p)));
+            say(format_args!("wrote {}", show_path(p)));
         }
         say(format_args!("charts are written as .png and .svg"));
     }
