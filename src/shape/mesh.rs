@@ -228,7 +228,7 @@ impl Mesh {
                 return Err(setting(
                     name,
                     format!(
-                        "the transform collapses all {} triangles to zero area ({before} had an area before it): {cause}; expected a transform that keeps the triangles apart",
+                        "the transform collapses every triangle to zero area (given: {}, with an area before it: {before}): {cause}; expected a transform that keeps the triangles apart",
                         indices.len()
                     ),
                 ));
