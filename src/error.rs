@@ -90,9 +90,9 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Io { path, source } => write!(f, "{}: {}", path.display(), source),
+            Error::Io { path, source } => write!(f, "{}: {}", show_path(path), source),
             Error::Scene { path, position, field, message } => {
-                write!(f, "{}", path.display())?;
+                write!(f, "{}", show_path(path))?;
                 if let Some((line, col)) = position {
                     write!(f, ":{line}:{col}")?;
                 }
@@ -101,9 +101,9 @@ impl fmt::Display for Error {
                 }
                 write!(f, ": {message}")
             }
-            Error::Mesh { path, message } => write!(f, "mesh {}: {}", path.display(), message),
-            Error::Image { path, message } => write!(f, "image {}: {}", path.display(), message),
-            Error::Checkpoint { path, message } => write!(f, "checkpoint {}: {}", path.display(), message),
+            Error::Mesh { path, message } => write!(f, "mesh {}: {}", show_path(path), message),
+            Error::Image { path, message } => write!(f, "image {}: {}", show_path(path), message),
+            Error::Checkpoint { path, message } => write!(f, "checkpoint {}: {}", show_path(path), message),
             Error::Settings(message) | Error::Mismatch(message) => write!(f, "{message}"),
             Error::Setting { name, message } => write!(f, "{name}: {message}"),
         }
@@ -115,6 +115,27 @@ impl std::error::Error for Error {
         match self {
             Error::Io { source, .. } => Some(source),
             _ => None,
+        }
+    }
+}
+
+/// A path as messages print it (see [`show_path`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ShowPath<'a>(&'a Path);
+
+/// A path for a message: as is when it is plain text, else quoted with its
+/// control characters (a newline, a tab), quotes, backslashes and any bytes
+/// that are not UTF-8 escaped, so that a message stays one line and shows
+/// where the path ends. Every message that prints a path prints it this way.
+pub fn show_path(path: &Path) -> ShowPath<'_> {
+    ShowPath(path)
+}
+
+impl fmt::Display for ShowPath<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0.to_str() {
+            Some(s) if !s.chars().any(char::is_control) => f.write_str(s),
+            _ => write!(f, "{:?}", self.0),
         }
     }
 }

@@ -14,7 +14,9 @@
 //!
 //! **Rough glass** (`roughness: A`, GGX α, 0 = smooth): a microfacet
 //! interface with reflection and transmission ([`super::rough_dielectric`]);
-//! below α = 1e-3 it is the smooth model exactly. A dispersive rough glass
+//! below α = 1e-3 it is the smooth model exactly. Where the relative index
+//! is 1 (glass of index 1, or inside the same glass) an uncoated rough
+//! interface passes light straight through, as a smooth one does. A dispersive rough glass
 //! still splits wavelengths in `auto` and `spectral` ([`super::Dispersion`]).
 //!
 //! **Absorption** (`absorption: SPECTRUM`, σ per scene unit per bin): light
@@ -259,6 +261,9 @@ impl Dielectric {
         if self.is_smooth() {
             return self.sample(wo, uc, eta);
         }
+        if rough_dielectric::index_matched(eta) {
+            return Self::pass_through(wo);
+        }
         let s = rough_dielectric::sample(Ggx { alpha: self.alpha }, wo, u, uc, eta)?;
         Some(BsdfSample { wi: s.wi, f: Sampled::splat(s.f), pdf: s.pdf, is_delta: false, eta: s.etap })
     }
@@ -347,6 +352,17 @@ impl Dielectric {
         }
         let t = Sampled(r.0.map(|x| 1.0 - x));
         Some(BsdfSample { wi, f: t / (wi.z.abs() * etap * etap), pdf: 1.0 - p, is_delta: true, eta: etap })
+    }
+
+    /// The straight pass-through of an index-matched rough interface: the
+    /// delta `wi = −wo` of probability 1 and weight `f |cos θi| / pdf = 1`, as
+    /// the smooth interface of index 1 refracts (see [`rough_dielectric`]).
+    #[inline]
+    fn pass_through<const N: usize>(wo: Vec3) -> Option<BsdfSample<N>> {
+        if wo.z.abs() < f32::MIN_POSITIVE {
+            return None;
+        }
+        Some(BsdfSample { wi: -wo, f: Sampled::splat(1.0 / wo.z.abs()), pdf: 1.0, is_delta: true, eta: 1.0 })
     }
 
     /// The refraction alone for index `eta`, as a sample of probability 1

@@ -16,6 +16,15 @@
 //! Jacobian of reflection `1 / (4 |wo·wm|)` or refraction
 //! `|wi·wm| / (wi·wm + wo·wm / η')²`.
 //!
+//! **Index-matched** (`|η − 1| ≤` [`INDEX_MATCHED`], e.g. glass inside the
+//! same glass, or `ior: Constant(1.0)` in vacuum): every microfacet transmits
+//! straight on, so the refracted lobe collapses to the delta `wi = −wo` with
+//! weight 1 (as the smooth interface of index 1) and Fresnel reflects
+//! nothing. The microfacet formulas above divide by a generalised half
+//! vector that vanishes there and lose light, so [`eval`] and [`pdf`] give 0
+//! and the caller samples the delta pass-through instead
+//! ([`super::Dielectric`]'s `sample_any`).
+//!
 //! **Coated** (a thin film on every microfacet, [`super::thin_film`]): the
 //! film's reflectance `R(λ, wo·wm)` replaces `F` per wavelength in `f`
 //! ([`eval_coated`]), and the lobe is chosen with the packet's mean `P(wo·wm)`
@@ -27,6 +36,17 @@ use glam::{Vec2, Vec3};
 use super::fresnel_dielectric;
 use super::microfacet::Ggx;
 use crate::color::Sampled;
+
+/// How far from 1 a relative index may be and still count as index-matched
+/// (a few f32 ulps: equal indices divide to exactly 1).
+pub(super) const INDEX_MATCHED: f32 = 1e-6;
+
+/// True when the relative index `eta` is 1 within [`INDEX_MATCHED`]: the
+/// interface passes light straight through.
+#[inline]
+pub(super) fn index_matched(eta: f32) -> bool {
+    (eta - 1.0).abs() <= INDEX_MATCHED
+}
 
 /// A sampled direction of the rough interface: `wi`, `f`, pdf and `η'`.
 pub(super) struct RoughSample {
@@ -89,9 +109,13 @@ pub(super) fn eval_coated<const N: usize>(
     Sampled(f.0.map(|v| if v.is_finite() && v > 0.0 { v } else { 0.0 }))
 }
 
-/// `f(wo, wi)` of the rough interface for relative index `eta`.
+/// `f(wo, wi)` of the rough interface for relative index `eta` (0 when
+/// index-matched: the pass-through is a delta).
 #[inline]
 pub(super) fn eval(g: Ggx, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    if index_matched(eta) {
+        return 0.0;
+    }
     let Some((wm, etap)) = half_vector(wo, wi, eta) else {
         return 0.0;
     };
@@ -107,9 +131,12 @@ pub(super) fn eval(g: Ggx, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
     if v.is_finite() && v > 0.0 { v } else { 0.0 }
 }
 
-/// The pdf of [`sample`] choosing `wi`.
+/// The pdf of [`sample`] choosing `wi` (0 when index-matched).
 #[inline]
 pub(super) fn pdf(g: Ggx, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+    if index_matched(eta) {
+        return 0.0;
+    }
     pdf_with(g, wo, wi, eta, |c| fresnel_dielectric(c, eta))
 }
 

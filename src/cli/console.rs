@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use rust_v::error::{Error, Result};
+use rust_v::error::{Error, Result, show_path};
 use rust_v::render::{Progress, RenderStats};
 use rust_v::scene::Scene;
 
@@ -56,28 +56,42 @@ pub fn out(text: &str) -> Result<()> {
         .map_err(|e| Error::Settings(format!("cannot write to standard output: {e}")))
 }
 
+/// `n` and a noun, plural unless `n` is 1: `count(1, "pass")` is "1 pass",
+/// `count(2, "pass")` "2 passes", `count(3, "light")` "3 lights". Every count
+/// printed with a noun goes through here.
+pub fn count(n: impl Into<u64>, noun: &str) -> String {
+    let n = n.into();
+    if n == 1 {
+        format!("1 {noun}")
+    } else if noun.ends_with('s') || noun.ends_with('x') || noun.ends_with("ch") || noun.ends_with("sh") {
+        format!("{n} {noun}es")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 /// Prints the warnings and the summary of a finished render.
 pub fn report(scene: &Scene, stats: &RenderStats, output: &Path, quiet: bool) {
     if stats.clamped_samples > 0 {
         warn(format_args!(
             "{} {} brighter than the film's range ±2^31 and clamped: the image is darker there than the scene",
-            stats.clamped_samples,
-            if stats.clamped_samples == 1 { "sample was" } else { "samples were" }
+            count(stats.clamped_samples, "sample"),
+            if stats.clamped_samples == 1 { "was" } else { "were" }
         ));
     }
     if stats.invalid_samples > 0 {
         warn(format_args!(
             "{} {} NaN or infinite and dropped: a bug, please report it with the scene",
-            stats.invalid_samples,
-            if stats.invalid_samples == 1 { "sample was" } else { "samples were" }
+            count(stats.invalid_samples, "sample"),
+            if stats.invalid_samples == 1 { "was" } else { "were" }
         ));
     }
     if !quiet {
         let samples = stats.passes as f64 * scene.settings.width as f64 * scene.settings.height as f64;
         say(format_args!(
-            "wrote {} ({} passes in {:.2} s, {:.3} Msamples/s)",
-            output.display(),
-            stats.passes,
+            "wrote {} ({} in {:.2} s, {:.3} Msamples/s)",
+            show_path(output),
+            count(stats.passes, "pass"),
             stats.elapsed.as_secs_f64(),
             samples / stats.elapsed.as_secs_f64().max(1e-9) / 1e6
         ));

@@ -12,13 +12,13 @@ use std::time::Instant;
 
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
 use rust_v::color::ColorSpace;
-use rust_v::error::{Error, Result};
+use rust_v::error::{Error, Result, show_path};
 use rust_v::film::{Film, MAX_SAMPLE};
 use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, parent_dir};
 use rust_v::scene::{Scene, load_scene};
 
 use super::args::{MergeArgs, RenderArgs, ResumeArgs};
-use super::console::{say, warn};
+use super::console::{count, say, warn};
 use super::session::{Session, SessionPlan};
 
 fn default_output(scene: &Path) -> PathBuf {
@@ -34,7 +34,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     check_output_extension(&output)?;
     check_color_space(&output, args.color_space)?;
     if args.spectral && !rust_v::io::image::is_exr(&output) {
-        return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", output.display())));
+        return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", show_path(&output))));
     }
     let load_start = Instant::now();
     let scene = load_scene(&args.scene, &args.settings.overrides())?;
@@ -56,15 +56,15 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     }
     if !args.run.quiet {
         say(format_args!(
-            "{} ({} objects, {} lights, loaded in {:.2} s): {}x{}, {} spp, {} bounces, seed {}",
-            args.scene.display(),
-            scene.object_count(),
-            scene.lights.len(),
+            "{} ({}, {}, loaded in {:.2} s): {}x{}, {} spp, {}, seed {}",
+            show_path(&args.scene),
+            count(scene.object_count() as u64, "object"),
+            count(scene.lights.len() as u64, "light"),
             load_time.as_secs_f64(),
             s.width,
             s.height,
             s.spp,
-            s.max_bounces,
+            count(s.max_bounces, "bounce"),
             s.seed,
         ));
         say(format_args!("{}", rust_v::integrator::describe(&scene)));
@@ -100,7 +100,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     if ckpt.crate_version != env!("CARGO_PKG_VERSION") {
         warn(format_args!(
             "{} was written by rust-v {}, this is {}: new passes may differ from what it would have rendered",
-            path.display(),
+            show_path(path),
             ckpt.crate_version,
             env!("CARGO_PKG_VERSION")
         ));
@@ -118,20 +118,17 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     check_color_space(&output, args.color_space)?;
     ckpt.film.set_color_space(args.color_space);
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
-        .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", ckpt.scene_path.display())))?;
+        .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?;
     if scene.content_hash != ckpt.content_hash && args.force {
-        warn(format_args!(
-            "{} or a file it reads changed since the checkpoint was written; resuming anyway (--force)",
-            ckpt.scene_path.display()
-        ));
+        warn(format_args!("{}; resuming anyway (--force)", changed_inputs(path, &ckpt.scene_path, &scene.inputs)));
         ckpt.content_hash = scene.content_hash;
     }
     if scene.content_hash != ckpt.content_hash {
         return Err(Error::checkpoint(
             path,
             format!(
-                "the scene {} or a file it reads (mesh, data) changed since the checkpoint was written (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
-                ckpt.scene_path.display(),
+                "{} (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
+                changed_inputs(path, &ckpt.scene_path, &scene.inputs),
                 scene.content_hash,
                 ckpt.content_hash
             ),
@@ -144,8 +141,8 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     if !args.run.quiet {
         say(format_args!(
             "resuming {} ({}): passes {}..{} done, rendering to pass {}",
-            path.display(),
-            ckpt.scene_path.display(),
+            show_path(path),
+            show_path(&ckpt.scene_path),
             done.start,
             done.end,
             end.max(done.end)
@@ -172,11 +169,44 @@ fn same_file(a: &Path, b: &Path) -> bool {
     a == b || matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
 }
 
+/// Says which inputs of a resumed scene changed, as far as can be told. The
+/// checkpoint stores one hash over the scene file and every file it reads
+/// (meshes, data), not one per file, so: a scene that reads no other file
+/// changed itself; otherwise the inputs modified after the checkpoint file
+/// was written are named; when none was (or the times cannot be read), every
+/// input is named as possibly changed.
+fn changed_inputs(checkpoint: &Path, scene: &Path, inputs: &[PathBuf]) -> String {
+    if inputs.is_empty() {
+        return format!("the scene file {} changed since the checkpoint was written", show_path(scene));
+    }
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let all: Vec<&Path> = std::iter::once(scene).chain(inputs.iter().map(|p| p.as_path())).collect();
+    let newer: Vec<&Path> = match modified(checkpoint) {
+        Some(written) => all.iter().copied().filter(|p| modified(p).is_some_and(|t| t > written)).collect(),
+        None => Vec::new(),
+    };
+    let names = |ps: &[&Path]| ps.iter().map(|p| show_path(p).to_string()).collect::<Vec<_>>().join(", ");
+    if newer.is_empty() {
+        format!(
+            "the scene {} or a file it reads (mesh, data: {}) changed since the checkpoint was written; none was modified after it, and the checkpoint keeps one hash over them all, so which is not known",
+            show_path(scene),
+            names(&all[1..])
+        )
+    } else {
+        format!(
+            "the scene {} or a file it reads (mesh, data) changed since the checkpoint was written: {} modified after it",
+            show_path(scene),
+            names(&newer)
+        )
+    }
+}
+
 pub fn merge_command(args: MergeArgs) -> Result<()> {
     let is_ckpt = args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("ckpt"));
     if !is_ckpt {
-        check_output_extension(&args.output)
-            .map_err(|_| Error::Settings(format!("output {}: expected .png, .exr or .ckpt", args.output.display())))?;
+        check_output_extension(&args.output).map_err(|_| {
+            Error::Settings(format!("output {}: expected .png, .exr or .ckpt", show_path(&args.output)))
+        })?;
     }
     check_output(&args.output, "output")?;
     let inputs: Vec<(&str, &Path)> = args.parts.iter().map(|p| ("checkpoint", p.as_path())).collect();
@@ -198,11 +228,11 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     if !args.quiet {
         let r = merged.passes();
         say(format_args!(
-            "merged {} checkpoints (passes {}..{}) into {}",
-            args.parts.len(),
+            "merged {} (passes {}..{}) into {}",
+            count(args.parts.len() as u64, "checkpoint"),
             r.start,
             r.end,
-            args.output.display()
+            show_path(&args.output)
         ));
     }
     Ok(())
@@ -214,7 +244,7 @@ fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
         return Err(Error::Settings(format!(
             "--color-space {} needs an .exr output; {} is a PNG, always sRGB",
             space.name(),
-            output.display()
+            show_path(output)
         )));
     }
     Ok(())
@@ -223,7 +253,7 @@ fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
 fn check_output_extension(output: &Path) -> Result<()> {
     match output.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()) {
         Some(e) if e == "png" || e == "exr" => Ok(()),
-        _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", output.display()))),
+        _ => Err(Error::Settings(format!("output {}: expected a name ending in .png or .exr", show_path(output)))),
     }
 }
 
@@ -251,7 +281,7 @@ fn check_files(
     if stem.len() + "-4294967295.png".len() > NAME_MAX {
         return Err(Error::Settings(format!(
             "image {}: its snapshots (`{stem}-00128.png`) would have names longer than {NAME_MAX} bytes; choose a shorter name",
-            output.display()
+            show_path(output)
         )));
     }
     let dir = std::fs::canonicalize(parent_dir(output)).ok();
@@ -260,12 +290,13 @@ fn check_files(
         if same_dir && path.file_name().is_some_and(|n| is_snapshot_name(n, &stem)) {
             return Err(Error::Settings(format!(
                 "{role} {} has the name of a snapshot of {}: a snapshot would overwrite it",
-                path.display(),
-                output.display()
+                show_path(path),
+                show_path(output)
             )));
         }
     }
     check_memory(scene.settings.width, scene.settings.height, spectral)?;
+    warn_no_effect(scene);
     for (i, light) in scene.lights.iter().enumerate() {
         let peak = light.spectrum().max_value();
         if peak > MAX_SAMPLE {
@@ -278,6 +309,26 @@ fn check_files(
         }
     }
     Ok(())
+}
+
+/// Warns about what the scene asks for that cannot happen: a `priority` on an
+/// object that is not a dielectric (only dielectric volumes nest), and a
+/// scene without any light (the image is black).
+fn warn_no_effect(scene: &Scene) {
+    for (i, o) in scene.objects.iter().enumerate() {
+        let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
+        if o.priority != 0 && !dielectric {
+            warn(format_args!(
+                "objects[{i}].priority: {} has no effect: the object is not a dielectric, and only dielectric volumes nest by priority",
+                o.priority
+            ));
+        }
+    }
+    if scene.lights.is_empty() {
+        warn(format_args!(
+            "the scene has no light (no `lights` and no object with an `emission`): the image will be black"
+        ));
+    }
 }
 
 /// Refuses a render larger than the memory this process may take: the least of

@@ -34,13 +34,13 @@ use std::time::{Duration, Instant};
 use signal_hook::SigId;
 
 use rust_v::checkpoint::{Checkpoint, snapshot_path};
-use rust_v::error::{Error, Result};
+use rust_v::error::{Error, Result, show_path};
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
 use rust_v::scene::Scene;
 
 use super::args::{CheckpointArgs, RunArgs};
-use super::console::{ProgressView, report, thread_pool};
+use super::console::{ProgressView, count, report, thread_pool};
 
 /// Where a session writes and how it runs.
 pub struct SessionPlan {
@@ -168,7 +168,7 @@ impl Session {
             if let Ok(msg) = snapshot {
                 view.note(format_args!("stopped by a signal: {msg}"));
             }
-            view.note(format_args!("continue with: rust-v resume {}", saved.display()));
+            view.note(format_args!("continue with: rust-v resume {}", show_path(&saved)));
         }
         if !stats.interrupted {
             // The checkpoint first: making the image allocates its buffers, and a
@@ -178,14 +178,15 @@ impl Session {
             if let Err(e) = ckpt.film.write(&plan.output) {
                 let saved = save_work(&ckpt, plan, Some(&e))?;
                 return Err(Error::Settings(format!(
-                    "{e}; the render's {} passes are saved in {}: continue with `rust-v resume {} -o OTHER.png`",
-                    ckpt.film.passes(),
-                    saved.display(),
-                    saved.display()
+                    "{e}; the render's {} {} saved in {}: continue with `rust-v resume {} -o OTHER.png`",
+                    count(ckpt.film.passes(), "pass"),
+                    if ckpt.film.passes() == 1 { "is" } else { "are" },
+                    show_path(&saved),
+                    show_path(&saved)
                 )));
             }
             if let Some(saved) = checkpoint {
-                view.note(format_args!("wrote checkpoint {}", saved.display()));
+                view.note(format_args!("wrote checkpoint {}", show_path(&saved)));
             }
             report(scene, &stats, &plan.output, plan.quiet);
         }
@@ -222,14 +223,14 @@ fn save_work(ckpt: &Checkpoint, plan: &SessionPlan, cause: Option<&Error>) -> Re
     let fallback = fallback_path(&plan.checkpoint_path);
     match ckpt.write_with(&ckpt.film, &fallback) {
         Ok(_) => {
-            super::console::warn(format_args!("{first}; the checkpoint went to {} instead", fallback.display()));
+            super::console::warn(format_args!("{first}; the checkpoint went to {} instead", show_path(&fallback)));
             Ok(fallback)
         }
         Err(second) => {
             let cause = cause.map(|c| format!("{c}; ")).unwrap_or_default();
             Err(Error::Settings(format!(
-                "{cause}{first}; {second}: the render's {} passes could not be saved anywhere",
-                ckpt.film.passes()
+                "{cause}{first}; {second}: the render's {} could not be saved anywhere",
+                count(ckpt.film.passes(), "pass")
             )))
         }
     }
@@ -245,7 +246,7 @@ fn fallback_path(checkpoint: &Path) -> PathBuf {
 fn write_snapshot(film: &Film, plan: &SessionPlan) -> Result<String> {
     let path = snapshot_path(&plan.output, film.passes());
     film.write(&path)?;
-    Ok(format!("wrote snapshot {} ({} passes)", path.display(), film.passes()))
+    Ok(format!("wrote snapshot {} ({})", show_path(&path), count(film.passes(), "pass")))
 }
 
 fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<String> {
@@ -254,7 +255,7 @@ fn write_checkpoint(ckpt: &Checkpoint, film: &Film, path: &Path) -> Result<Strin
     let r = film.pass_range();
     Ok(format!(
         "wrote checkpoint {} (passes {}..{}, {:.2} MB in {:.0} ms)",
-        path.display(),
+        show_path(path),
         r.start,
         r.end,
         size as f64 / 1e6,

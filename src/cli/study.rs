@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use rust_v::error::{Error, Result};
+use rust_v::error::{Error, Result, show_path};
 use rust_v::scene::load_scene;
 use rust_v::study::chart::{self, Chart, Series};
 use rust_v::study::converge::{self, Method, Record, SUMMARY_METRICS, Schedule, Summary};
@@ -24,10 +24,10 @@ fn compare_files(a: &Path, b: &Path) -> Result<(Image, Image, Metrics)> {
     if (ia.width, ia.height) != (ib.width, ib.height) {
         return Err(Error::Settings(format!(
             "images differ in size: {} is {}x{}, {} is {}x{}",
-            a.display(),
+            show_path(a),
             ia.width,
             ia.height,
-            b.display(),
+            show_path(b),
             ib.width,
             ib.height
         )));
@@ -108,8 +108,8 @@ pub fn compare_command(args: CompareArgs) -> Result<()> {
             let _ = writeln!(o, $($t)*);
         };
     }
-    w!("A: {} ({})", args.a.display(), describe(ia.source));
-    w!("B: {} ({}) [reference]", args.b.display(), describe(ib.source));
+    w!("A: {} ({})", show_path(&args.a), describe(ia.source));
+    w!("B: {} ({}) [reference]", show_path(&args.b), describe(ib.source));
     w!("size: {}x{}", ia.width, ia.height);
     w!("thesis metrics (16-bit sRGB codes, pixel = RGB vector, L = {THESIS_L:.4}):");
     w!("  MSE       {:.6e}   (eq. 4.6, mean squared Euclidean RGB distance)", m.mse);
@@ -157,7 +157,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
     if (w, h) != (reference.width, reference.height) {
         return Err(Error::Settings(format!(
             "the render is {w}x{h} but the reference {} is {}x{}",
-            args.reference.display(),
+            show_path(&args.reference),
             reference.width,
             reference.height
         )));
@@ -282,7 +282,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
     }
     if !args.run.quiet {
         for p in &written {
-            say(format_args!("wrote {}", p.display()));
+            say(format_args!("wrote {}", show_path(p)));
         }
         say(format_args!("charts are written as .png and .svg"));
     }

@@ -9,8 +9,8 @@ use super::check::{Check, MAX_MAGNITUDE};
 use super::desc::{IorDesc, SpectrumDesc};
 use crate::bxdf::{Ior, NAMED_GLASSES, named_glass};
 use crate::color::{self, N_BINS, Spectrum};
-use crate::error::{Error, Result};
-use crate::io::parse_spectrum_file;
+use crate::error::{Error, Result, show_path};
+use crate::io::parse_spectrum_rows;
 
 /// What a spectrum describes: it decides what `Rgb(r, g, b)` means.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -21,6 +21,24 @@ enum Role {
     Emission,
 }
 
+impl Role {
+    /// The largest value allowed.
+    fn limit(self) -> f32 {
+        match self {
+            Role::Reflectance => 1.0,
+            Role::Emission => MAX_MAGNITUDE,
+        }
+    }
+
+    /// What is wrong with value `v` and the range that applies.
+    fn out_of_range(self, v: f32) -> String {
+        match self {
+            Role::Reflectance => format!("a reflectance must lie in [0, 1], found {v}"),
+            Role::Emission => format!("expected a finite, non-negative value up to {MAX_MAGNITUDE:e}, found {v}"),
+        }
+    }
+}
+
 impl Check<'_> {
     /// A text file the scene refers to (a spectrum table), read through
     /// [`Check::read_input`] like every input: the resolved path and the text.
@@ -28,7 +46,7 @@ impl Check<'_> {
         let (path, bytes) = self.read_input(field, rel)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let at = e.utf8_error().valid_up_to();
-            self.err(field, format!("\"{}\": byte {at} is not UTF-8; expected a UTF-8 text file", path.display()))
+            self.err(field, format!("{}: byte {at} is not UTF-8; expected a UTF-8 text file", show_path(&path)))
         })?;
         Ok((path, text))
     }
@@ -60,8 +78,14 @@ impl Check<'_> {
         self.spectrum_as(field, s, Role::Emission)
     }
 
-    /// A spectrum in a role; the role decides what `Rgb` means.
+    /// A spectrum in a role; the role decides what `Rgb` means and which values are allowed.
     fn spectrum_as(&self, field: &str, s: &SpectrumDesc, role: Role) -> Result<Spectrum> {
+        self.spectrum_in(field, s, role, true)
+    }
+
+    /// [`Check::spectrum_as`]; `direct` when the values are used as they stand (not
+    /// under `Scaled` or `Luminance`), so a file's rows can be checked one by one.
+    fn spectrum_in(&self, field: &str, s: &SpectrumDesc, role: Role, direct: bool) -> Result<Spectrum> {
         let out = match s {
             SpectrumDesc::Constant(v) => Spectrum::splat(*v),
             SpectrumDesc::Samples(v) => {
@@ -85,22 +109,30 @@ impl Check<'_> {
             SpectrumDesc::EqualEnergy => color::equal_energy(),
             SpectrumDesc::Blackbody(t) => color::blackbody(*t)
                 .ok_or_else(|| self.err(field, format!("expected a positive temperature in kelvin, found {t}")))?,
-            SpectrumDesc::Scaled(k, inner) => self.spectrum_as(field, inner, role)? * *k,
+            SpectrumDesc::Scaled(k, inner) => self.spectrum_in(field, inner, role, false)? * *k,
             SpectrumDesc::Table(points) => self.table(field, points)?,
             SpectrumDesc::File(rel) => {
                 let (path, text) = self.read_text_input(field, rel)?;
-                let points = parse_spectrum_file(&text).map_err(|e| Error::Scene {
+                // Errors in the data name the data file, the row's line and column, and the field.
+                let at = |(line, col), message| Error::Scene {
                     path: path.clone(),
-                    position: Some((e.line, e.col)),
+                    position: Some((line, col)),
                     field: field.to_string(),
-                    message: e.message,
-                })?;
-                self.table(field, &points).map_err(|e| match e {
-                    Error::Scene { field, message, .. } => {
-                        Error::Scene { path: path.clone(), position: None, field, message }
+                    message,
+                };
+                let rows = parse_spectrum_rows(&text).map_err(|e| at((e.line, e.col), e.message))?;
+                for r in &rows {
+                    if r.nm <= 0.0 {
+                        return Err(at((r.line, 1), format!("expected a positive wavelength in nm, found {}", r.nm)));
                     }
-                    e => e,
-                })?
+                    // Values used as they stand must lie in the role's range (a scaled file is
+                    // checked after scaling, below).
+                    if direct && !(0.0..=role.limit()).contains(&r.value) {
+                        return Err(at((r.line, r.value_col), role.out_of_range(r.value)));
+                    }
+                }
+                let points: Vec<(f32, f32)> = rows.iter().map(|r| (r.nm, r.value)).collect();
+                Spectrum::from_table(&points)
             }
             SpectrumDesc::Rgb(r, g, b) => {
                 let rgb = [*r, *g, *b];
@@ -116,7 +148,7 @@ impl Check<'_> {
                 }
             }
             SpectrumDesc::Luminance(y, inner) => {
-                let s = self.spectrum_as(field, inner, role)?;
+                let s = self.spectrum_in(field, inner, role, false)?;
                 let have = s.to_xyz().y;
                 if !(y.is_finite() && *y >= 0.0 && *y <= MAX_MAGNITUDE) {
                     return Err(self.err(field, format!("expected a luminance in [0, {MAX_MAGNITUDE:e}], found {y}")));
@@ -127,8 +159,14 @@ impl Check<'_> {
                 s * (*y / have)
             }
         };
-        if out.has_nan_or_inf() || out.min_value() < 0.0 || out.max_value() > MAX_MAGNITUDE {
-            return Err(self.err(field, format!("expected finite, non-negative values up to {MAX_MAGNITUDE:e}")));
+        if out.has_nan_or_inf() {
+            return Err(self.err(field, role.out_of_range(f32::NAN)));
+        }
+        if out.min_value() < 0.0 {
+            return Err(self.err(field, role.out_of_range(out.min_value())));
+        }
+        if out.max_value() > role.limit() {
+            return Err(self.err(field, role.out_of_range(out.max_value())));
         }
         Ok(out)
     }

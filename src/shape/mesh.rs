@@ -125,7 +125,7 @@ impl Mesh {
     }
 
     fn build(
-        mut positions: Vec<Vec3>,
+        positions: Vec<Vec3>,
         indices: Vec<[u32; 3]>,
         mut normals: Option<Vec<Vec3>>,
         uvs: Option<Vec<[f32; 2]>>,
@@ -163,17 +163,22 @@ impl Mesh {
         {
             return Err(err(format!("{} normals for {} vertices", ns.len(), positions.len())));
         }
-        for (i, p) in positions.iter_mut().enumerate() {
+        // The file's positions stay until the triangles are checked: a transform that
+        // collapses them (in f32) is told apart from a mesh that was degenerate already.
+        let original = positions;
+        let mut positions = Vec::with_capacity(original.len());
+        for (i, p) in original.iter().enumerate() {
             if !p.is_finite() {
                 return Err(err(format!("vertex {i} has a non-finite coordinate {p}")));
             }
-            *p = m * *p + translate;
-            if !p.is_finite() {
+            let q = m * *p + translate;
+            if !q.is_finite() {
                 return Err(setting(
                     "scale",
                     format!("vertex {i} leaves f32's range after the transform: the scale or translation is too large"),
                 ));
             }
+            positions.push(q);
         }
         if let Some(ns) = normals.as_mut() {
             let nm = m.inverse().transpose();
@@ -201,8 +206,36 @@ impl Mesh {
             }
         }
         if kept.is_empty() {
+            let has_area = |p: &dyn Fn(u32) -> Vec3| {
+                indices
+                    .iter()
+                    .filter(|t| {
+                        let [a, b, c] = t.map(p);
+                        let area2 = (b - a).cross(c - a).length_squared();
+                        area2 > 0.0 && area2.is_finite()
+                    })
+                    .count()
+            };
+            let before = has_area(&|i| original[i as usize]);
+            if before > 0 {
+                // Valid triangles collapsed: by the translation when the linear part alone keeps them.
+                let name = if has_area(&|i| m * original[i as usize]) > 0 { "translate" } else { "scale" };
+                let cause = if name == "translate" {
+                    format!("the translation {translate} is too large for the mesh's size (f32 keeps about 7 digits)")
+                } else {
+                    "the scale or rotation shrinks them below f32's precision".to_string()
+                };
+                return Err(setting(
+                    name,
+                    format!(
+                        "the transform collapses every triangle to zero area (given: {}, with an area before it: {before}): {cause}; expected a transform that keeps the triangles apart",
+                        indices.len()
+                    ),
+                ));
+            }
             return Err(err(format!("no valid triangles ({} given, {} of zero area)", indices.len(), dropped.len())));
         }
+        drop(original);
         if kept.len() > MAX_BLOCKS {
             return Err(err(format!("{} triangles: at most {MAX_BLOCKS} are supported", kept.len())));
         }
