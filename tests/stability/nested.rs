@@ -30,8 +30,17 @@ fn water_in_glass(eye: &str, look_at: &str, glass_priority: u32, water_priority:
 #[test]
 fn nested_dielectrics_follow_the_medium_stack() {
     let want = 1.33f64.powi(2);
-    for m in METHODS.into_iter().filter(|m| *m != "lighttrace") {
+    for m in METHODS {
         let film = render_str(&water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", 0, 0), &method(m, 16, 6));
+        if m == "lighttrace" {
+            // Seen through glass: exactly 0 inside; from outside only the enclosure around the spheres.
+            assert!(y(&film).iter().all(|&v| v == 0.0), "lighttrace: nothing through glass");
+            let film = render_str(&water_in_glass("(0, 0, 4)", "(0, 0, 0)", 0, 0), &method(m, 32, 7));
+            let cover =
+                sphere_cover(glam::Vec3::new(0.0, 0.0, 4.0), glam::Vec3::ZERO, 35.0, 8, &[(glam::Vec3::ZERO, 1.0)]);
+            lighttrace_sees_only_the_enclosure(&film, &cover, "water in glass from outside");
+            continue;
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("nested, camera in water, {m}: Y = {mean:.4} ± {se:.4} (want {want:.4}; without a stack 3.98)");
         assert!((mean - want).abs() < 5.0 * se + 1e-3 * want, "{m}: {mean} ± {se}");
@@ -57,6 +66,12 @@ fn nested_dielectrics_follow_the_medium_stack() {
 /// holds one medium, so the enclosure is in equilibrium. Tolerances as above.
 #[test]
 fn priority_decides_which_medium_fills_an_overlap() {
+    for (glass, water) in [(1, 0), (0, 1)] {
+        // Light tracing sees both inside views through glass: exactly 0.
+        let film =
+            render_str(&water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", glass, water), &method("lighttrace", 16, 8));
+        assert!(y(&film).iter().all(|&v| v == 0.0), "lighttrace, priorities {glass} {water}");
+    }
     for m in ["whitted", "path", "hero", "auto", "bdpt"] {
         for (glass, water, want) in [(1, 0, 2.25f64), (0, 1, 1.7689)] {
             let film = render_str(&water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", glass, water), &method(m, 16, 8));
@@ -195,6 +210,10 @@ fn medium_stack_overflow_and_inconsistent_geometry() {
     let spheres: Vec<String> = (0..10)
         .map(|i| format!("(shape: Sphere(center: (0, 0, 0), radius: {}), material: \"glass\")", 1.0 - 0.08 * i as f64))
         .collect();
+    let parse = |v: &str| {
+        let c: Vec<f32> = v.trim_matches(['(', ')']).split(',').map(|x| x.trim().parse().unwrap()).collect();
+        glam::Vec3::new(c[0], c[1], c[2])
+    };
     for (eye, look_at, want) in [("(0, 0, 0)", "(0.3, 0.2, -1)", 2.25), ("(0, 0, 4)", "(0, 0, 0)", 1.0)] {
         let scene = format!(
             r#"(camera: (eye: {eye}, look_at: {look_at}, fov_deg: 35), render: (width: 8, height: 8, max_bounces: 64),
@@ -202,6 +221,9 @@ fn medium_stack_overflow_and_inconsistent_geometry() {
             objects: [ {}, {ENCLOSURE} ])"#,
             spheres.join(", ")
         );
+        let film = render_str(&scene, &method("lighttrace", 16, 14));
+        let cover = sphere_cover(parse(eye), parse(look_at), 35.0, 8, &[(glam::Vec3::ZERO, 1.0)]);
+        lighttrace_sees_only_the_enclosure(&film, &cover, &format!("ten nested spheres from {eye}"));
         for m in ["whitted", "path", "auto", "bdpt"] {
             let film = render_str(&scene, &method(m, 16, 14));
             let (mean, se) = mean_and_stderr(&film, 1);
@@ -214,6 +236,8 @@ fn medium_stack_overflow_and_inconsistent_geometry() {
         materials: {{ "glass": Dielectric(ior: Constant(1.5)) }},
         objects: [ (shape: Quad(origin: (-1, -1, 0), edge_u: (2, 0, 0), edge_v: (0, 2, 0)), material: "glass"), {ENCLOSURE} ])"#
     );
+    // Light tracing sees the enclosure only through the quad: exactly 0.
+    assert!(y(&render_str(&quad, &method("lighttrace", 16, 15))).iter().all(|&v| v == 0.0), "lighttrace, quad");
     for m in ["whitted", "path", "auto", "bdpt"] {
         let film = render_str(&quad, &method(m, 64, 15));
         let (mean, se) = mean_and_stderr(&film, 1);
@@ -242,8 +266,8 @@ fn a_false_intersection_leaves_the_emitter_to_bsdf_sampling() {
             (shape: Sphere(center: (0.2, 0, 0), radius: 0.15), material: "white"),
             (shape: Sphere(center: (0, 0, 0), radius: 1.5), emission: Constant(1), two_sided: true),
         ])"#;
-    for m in ["path", "hero", "auto", "bdpt"] {
-        let film = render_str(scene, &method(m, 64, 16));
+    for m in ["path", "hero", "auto", "bdpt", "lighttrace"] {
+        let film = render_str(scene, &method(m, if m == "lighttrace" { 1024 } else { 64 }, 16));
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("white ball past a false intersection, {m}: Y = {mean:.4} ± {se:.4}, want 1");
         assert!((mean - 1.0).abs() < 5.0 * se + 2e-3, "{m}: {mean} ± {se}");
@@ -273,6 +297,8 @@ fn dispersive_water_in_dispersive_glass() {
     let spectral: f64 =
         (0..36).map(|b| (water.at(rust_v::color::bin_lambda_nm(b)) as f64).powi(2) * cmf[b][1] as f64).sum();
     let reference = (water.at(589.3) as f64).powi(2);
+    // Light tracing: everything through glass, exactly 0.
+    assert!(y(&render_str(&scene, &method("lighttrace", 16, 17))).iter().all(|&v| v == 0.0), "lighttrace");
     for m in ["path", "hero", "auto", "bdpt"] {
         let film = render_str(&scene, &method(m, 32, 17));
         let (mean, se) = mean_and_stderr(&film, 1);
