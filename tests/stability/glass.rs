@@ -15,6 +15,7 @@ use super::*;
 /// with weight n², so full-spectrum methods are exact per pixel up to
 /// roulette ([`pixel_tol`]); the
 /// packet samplers' colour noise is checked on the image mean (5 s.e.).
+/// `lighttrace` sees everything through glass: exactly 0 in every pixel.
 #[test]
 fn camera_inside_glass_sees_n_squared_l() {
     let scene = camera_in_glass();
@@ -38,6 +39,7 @@ fn camera_inside_glass_sees_n_squared_l() {
 /// wavelength: Y = Σ_b n(λ_b)² ȳ_b. `path` refracts every wavelength like
 /// 589.3 nm and so sees n(589.3)² L: its documented bias, measured here
 /// (0.3% in Y for N-BK7).
+/// `lighttrace`: exactly 0 in every pixel (seen through glass).
 #[test]
 fn camera_inside_dispersive_glass_sees_n_lambda_squared() {
     let scene = format!(
@@ -75,6 +77,7 @@ fn camera_inside_dispersive_glass_sees_n_lambda_squared() {
 /// gives exactly 0 (the path dies at max_bounces or by roulette) and
 /// 2.25 per pixel within [`pixel_tol`] (full spectrum) elsewhere; pixels whose
 /// footprint straddles b = R/n are skipped.
+/// `lighttrace` gives exactly 0 in the free pixels too (seen through glass).
 #[test]
 fn total_internal_reflection_traps_paths_in_a_sphere() {
     let scene = format!(
@@ -121,6 +124,8 @@ fn total_internal_reflection_traps_paths_in_a_sphere() {
 /// correctly: a camera in the cavity sees L (the two n² factors cancel) and
 /// from outside the bubble is invisible; image mean within 5 s.e. + 0.2%,
 /// and per pixel within [`pixel_tol`] for the full-spectrum methods.
+/// `lighttrace`: exactly 0 from the cavity and wherever the view is all shell,
+/// the enclosure beside it 1 ([`lighttrace_sees_only_the_enclosure`]).
 #[test]
 fn bubble_is_invisible_from_inside_and_outside() {
     let parse = |v: &str| {
@@ -328,6 +333,7 @@ fn caustic_through_a_glass_slab_matches_the_closed_form() {
 /// noisy: fireflies), `whitted` cannot (exactly 0). Path, hero, random and
 /// auto agree on the caustic region's mean within 5 combined standard
 /// errors (pixel spread), and the region is brighter than 0.
+/// `bdpt` and `lighttrace` (the floor is diffuse: unbiased) join the agreement.
 #[test]
 fn caustic_from_a_small_sphere_light() {
     // Power of a point light of intensity 2 ≈ a sphere of radiance 2 / (π r²).
@@ -362,6 +368,8 @@ fn caustic_from_a_small_sphere_light() {
 /// tests/README.md); asserted within 15% + 5 standard errors of the
 /// difference image (the glass redistributes a little light: the ball is a
 /// weak lens for rays leaving off-centre).
+/// `lighttrace` is held to the same bound: the floor is diffuse, lit through
+/// glass.
 #[test]
 fn light_inside_glass_is_reached_by_bsdf_sampling_only() {
     let scene = |glass: bool| {

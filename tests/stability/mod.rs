@@ -181,6 +181,8 @@ const ENCLOSURE: &str = "(shape: Sphere(center: (0, 0, 0), radius: 10), emission
 /// ρ I / (π R²) = 1/(2π) exactly (one deterministic shadow ray per sample).
 /// Tolerance for the sampled methods: 5 standard errors of the image mean
 /// (from the pixel spread) plus 0.3% for the CMF normalisation and f32.
+/// `lighttrace` is unbiased here (every vertex diffuse) and held to the same
+/// tolerance.
 #[test]
 fn lambertian_sphere_with_a_point_light_at_its_centre() {
     let scene = POINT_IN_SPHERE;
@@ -204,6 +206,8 @@ fn lambertian_sphere_with_a_point_light_at_its_centre() {
 /// (the specular furnace). `whitted` with B specular bounces gives exactly
 /// (1 − ρ^(B+1)) / (1 − ρ) (deterministic); path-based methods are exact up
 /// to Russian roulette noise after 5 bounces (5 standard errors + 0.3%).
+/// `lighttrace` sees the emission (s = 1) and none of its mirror reflections:
+/// L_e = 1 for every ρ, same tolerance.
 #[test]
 fn emitting_mirror_enclosure_is_le_over_one_minus_rho() {
     for rho in [0.5f64, 0.8] {
