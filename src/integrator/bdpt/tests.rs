@@ -204,10 +204,8 @@ fn independent_densities(eye: Vec3, forward: Vec3, fov_deg: f64, path: &[Point],
         .map(|i| {
             if i == 0 {
                 f64::NAN
-            } else if i == m {
-                1.0 // the light's area is 1
-            } else if delta == Some(i + 1) {
-                1.0
+            } else if i == m || delta == Some(i + 1) {
+                1.0 // the light's area is 1; a mirror's delta counts 1
             } else {
                 cos(i + 1, i) / PI * cos(i, i + 1) / d2(i, i + 1)
             }
