@@ -117,27 +117,24 @@ fn grazing_plane() -> String {
 
 /// For each pixel of a `size`x`size` view from `eye` towards `look_at`
 /// (field of view `fov_deg`, up +y): `Some(true)` when the rays through its
-/// four corners and its centre all hit one of `spheres` (centre, radius),
-/// `Some(false)` when none does, `None` when the pixel straddles an outline.
-fn sphere_cover(
+/// four corners and its centre all satisfy `hits`, `Some(false)` when none
+/// does, `None` when the pixel straddles an outline.
+fn cover(
     eye: glam::Vec3,
     look_at: glam::Vec3,
     fov_deg: f32,
     size: u32,
-    spheres: &[(glam::Vec3, f32)],
+    hits: impl Fn(&rust_v::geometry::Ray) -> bool,
 ) -> Vec<Option<bool>> {
     let cam = rust_v::camera::Camera::new(eye, look_at, glam::Vec3::Y, fov_deg, size, size);
-    let balls: Vec<_> = spheres.iter().map(|&(c, r)| rust_v::shape::Sphere::new(c, r)).collect();
     let mut cover = Vec::new();
     for py in 0..size {
         for px in 0..size {
-            let hits = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)].map(|(dx, dy)| {
-                let r = cam.ray(glam::Vec2::new(px as f32 + dx, py as f32 + dy));
-                balls.iter().any(|b| b.occluded(&r, f32::INFINITY))
-            });
-            cover.push(if hits.iter().all(|&h| h) {
+            let h = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)]
+                .map(|(dx, dy)| hits(&cam.ray(glam::Vec2::new(px as f32 + dx, py as f32 + dy))));
+            cover.push(if h.iter().all(|&h| h) {
                 Some(true)
-            } else if hits.iter().all(|&h| !h) {
+            } else if h.iter().all(|&h| !h) {
                 Some(false)
             } else {
                 None
@@ -145,6 +142,30 @@ fn sphere_cover(
         }
     }
     cover
+}
+
+/// [`cover`] by any of `spheres` (centre, radius).
+fn sphere_cover(
+    eye: glam::Vec3,
+    look_at: glam::Vec3,
+    fov_deg: f32,
+    size: u32,
+    spheres: &[(glam::Vec3, f32)],
+) -> Vec<Option<bool>> {
+    let balls: Vec<_> = spheres.iter().map(|&(c, r)| rust_v::shape::Sphere::new(c, r)).collect();
+    cover(eye, look_at, fov_deg, size, |r| balls.iter().any(|b| b.occluded(r, f32::INFINITY)))
+}
+
+/// Whether `ray` meets the axis-aligned box `lo`..`hi` (the slab test).
+fn hits_box(ray: &rust_v::geometry::Ray, lo: glam::Vec3, hi: glam::Vec3) -> bool {
+    let (mut t0, mut t1) = (0.0f32, f32::INFINITY);
+    for a in 0..3 {
+        let inv = 1.0 / ray.dir[a];
+        let (ta, tb) = ((lo[a] - ray.origin[a]) * inv, (hi[a] - ray.origin[a]) * inv);
+        t0 = t0.max(ta.min(tb));
+        t1 = t1.min(ta.max(tb));
+    }
+    t0 <= t1
 }
 
 /// Light tracing's answer for a view of smooth glass (or a thin sheet) in the

@@ -66,7 +66,9 @@ fn nested_dielectrics_follow_the_medium_stack() {
 /// above, it sees 1.33² L. Two partially overlapping spheres (1.5 and
 /// 1.33, each priority order) are invisible from outside: every region
 /// holds one medium, so the enclosure is in equilibrium. Tolerances as above.
-/// `lighttrace` sees both concentric views through glass: exactly 0.
+/// `lighttrace` sees both concentric views through glass: exactly 0; the
+/// overlapping pair from outside: exactly 0 where the view is all sphere,
+/// the enclosure beside them 1.
 #[test]
 fn priority_decides_which_medium_fills_an_overlap() {
     for (glass, water) in [(1, 0), (0, 1)] {
@@ -95,6 +97,13 @@ fn priority_decides_which_medium_fills_an_overlap() {
                     {ENCLOSURE},
                 ])"#
             );
+            if m == "whitted" {
+                // Light tracing sees the spheres through glass: exactly 0 there, the enclosure beside them 1.
+                let film = render_str(&scene, &method("lighttrace", 32, 9));
+                let spheres = [(glam::Vec3::new(-0.35, 0.0, 0.0), 0.6), (glam::Vec3::new(0.35, 0.1, 0.1), 0.6)];
+                let cover = sphere_cover(glam::Vec3::new(0.0, 0.0, 4.0), glam::Vec3::ZERO, 40.0, 10, &spheres);
+                lighttrace_sees_only_the_enclosure(&film, &cover, &format!("overlapping spheres, priorities {a} {b}"));
+            }
             let film = render_str(&scene, &method(m, 32, 9));
             let (mean, se) = mean_and_stderr(&film, 1);
             assert!((mean - 1.0).abs() < 5.0 * se + 1e-3, "{m}, priorities {a} {b}: overlap visible: {mean} ± {se}");
@@ -117,6 +126,8 @@ fn priority_decides_which_medium_fills_an_overlap() {
 /// medium, so in the uniform enclosure it is invisible from every side
 /// (image mean within 5 s.e. + 0.2%; `whitted`, without roulette, per pixel
 /// within 1%).
+/// `lighttrace`: exactly 0 wherever the view is all block, the enclosure beside
+/// it 1.
 #[test]
 fn a_glass_of_water_is_invisible_in_a_furnace() {
     for (eye, seed) in [("(0.3, 0.9, 4)", 10), ("(0.2, 3.5, 1.5)", 11)] {
@@ -134,6 +145,21 @@ fn a_glass_of_water_is_invisible_in_a_furnace() {
                 {ENCLOSURE},
             ])"#
         );
+        // Light tracing: exactly 0 wherever the view is all glass block (or the
+        // vacuum block above it), the enclosure beside it 1.
+        let film = render_str(&scene, &method("lighttrace", 32, seed));
+        let (glass, vacuum) = (
+            (glam::Vec3::new(-0.5, 0.0, -0.5), glam::Vec3::new(0.5, 1.4, 0.5)),
+            (glam::Vec3::new(-0.44, 0.89, -0.44), glam::Vec3::new(0.44, 1.6, 0.44)),
+        );
+        let eye_v = {
+            let c: Vec<f32> = eye.trim_matches(['(', ')']).split(',').map(|x| x.trim().parse().unwrap()).collect();
+            glam::Vec3::new(c[0], c[1], c[2])
+        };
+        let cover = cover(eye_v, glam::Vec3::new(0.0, 0.6, 0.0), 35.0, 12, |r| {
+            hits_box(r, glass.0, glass.1) || hits_box(r, vacuum.0, vacuum.1)
+        });
+        lighttrace_sees_only_the_enclosure(&film, &cover, &format!("glass of water from {eye}"));
         for m in ["whitted", "path", "auto", "bdpt"] {
             let film = render_str(&scene, &method(m, 32, seed));
             let (mean, se) = mean_and_stderr(&film, 1);
