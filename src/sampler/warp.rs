@@ -82,10 +82,23 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
 #[inline]
 pub fn power_heuristic(f: f32, g: f32) -> f32 {
     let (f2, g2) = (f * f, g * g);
-    if f2.is_infinite() {
+    let sum = f2 + g2;
+    if sum.is_normal() && sum.is_finite() {
+        return f2 / sum;
+    }
+    // Squares that overflow or underflow f32 (densities beyond about 1.8e19 or
+    // below 1e-19: rare, a point seen at a grazing angle, a tiny light): the
+    // ratio of the squares of `f / m` and `g / m`, `m` the larger density, in
+    // f64. An infinite density is a delta strategy and takes the whole weight.
+    if f.is_infinite() {
         return 1.0;
     }
-    if f2 + g2 == 0.0 { 0.0 } else { f2 / (f2 + g2) }
+    let m = f.max(g) as f64;
+    if m.is_nan() || m <= 0.0 || m.is_infinite() {
+        return 0.0;
+    }
+    let (a, b) = (f as f64 / m, g as f64 / m);
+    (a * a / (a * a + b * b)) as f32
 }
 
 #[cfg(test)]
@@ -138,5 +151,53 @@ mod tests {
             assert!((power_heuristic(a, b) + power_heuristic(b, a) - 1.0).abs() < 1e-6);
         }
         assert_eq!(power_heuristic(f32::INFINITY, 1.0), 1.0);
+    }
+
+    /// The power heuristic by value: f²/(f² + g²) (evaluated here in f64) for
+    /// densities over 30 orders of magnitude, equal, unequal, zero on either
+    /// side, and infinite (a delta strategy: it takes the whole weight, the
+    /// other none). Within 1e-6 absolute (f32), and each pair's two weights sum
+    /// to 1 within 1e-6 unless both are 0.
+    #[test]
+    fn power_heuristic_is_the_ratio_of_squares() {
+        let finite = [0.0f32, 1e-15, 1e-6, 0.01, 0.3, 1.0, 2.0, 3.0, 4.0, 7.5, 1e3, 1e6, 1e15];
+        for &a in &finite {
+            for &b in &finite {
+                let (a2, b2) = ((a as f64).powi(2), (b as f64).powi(2));
+                let want = if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) };
+                let got = power_heuristic(a, b) as f64;
+                assert!((got - want).abs() < 1e-6, "w({a}, {b}) = {got}, want {want}");
+                if a > 0.0 || b > 0.0 {
+                    let sum = got + power_heuristic(b, a) as f64;
+                    assert!((sum - 1.0).abs() < 1e-6, "w({a}, {b}) + w({b}, {a}) = {sum}");
+                }
+            }
+            if a < f32::INFINITY {
+                assert_eq!(power_heuristic(f32::INFINITY, a), 1.0, "a delta strategy against {a}");
+                assert_eq!(power_heuristic(a, f32::INFINITY), 0.0, "{a} against a delta strategy");
+            }
+        }
+        // Exact values: 1/(1 + 4), 9/25, 16/25, ½.
+        assert_eq!(power_heuristic(1.0, 2.0), 0.2);
+        assert!((power_heuristic(3.0, 4.0) - 0.36).abs() < 1e-7 && (power_heuristic(4.0, 3.0) - 0.64).abs() < 1e-7);
+        assert_eq!(power_heuristic(5.0, 5.0), 0.5);
+    }
+
+    /// Densities whose squares leave f32's range: above about 1.8e19 (f²
+    /// overflows) or below about 1e-23 (f² underflows to 0), the weights no
+    /// longer summed to 1: w(1e20, 1e20) = 1 for both orders (want ½ each),
+    /// w(1e20, 1e19) = 1 (want 0.990), w(1e-25, 1e-25) = 0 for both orders
+    /// (want ½), before `power_heuristic` fell back to scaling by the larger
+    /// density where the squares leave f32's range.
+    #[test]
+    fn power_heuristic_survives_extreme_densities() {
+        for (a, b) in [(1e20f32, 1e20f32), (1e20, 1e19), (1e30, 1.0), (1e-25, 1e-25), (1e-25, 1e-26), (1e-30, 1e-31)] {
+            let (a2, b2) = ((a as f64).powi(2), (b as f64).powi(2));
+            let want = a2 / (a2 + b2);
+            let got = power_heuristic(a, b) as f64;
+            assert!((got - want).abs() < 1e-6, "w({a}, {b}) = {got}, want {want}");
+            let sum = got + power_heuristic(b, a) as f64;
+            assert!((sum - 1.0).abs() < 1e-6, "w({a}, {b}) + w({b}, {a}) = {sum}");
+        }
     }
 }

@@ -27,11 +27,22 @@ fn water_in_glass(eye: &str, look_at: &str, glass_priority: u32, water_priority:
 /// medium stack starts as [glass, water] (found by probing from the eye).
 /// From outside, water in glass is invisible in the enclosure. Image means
 /// within 5 s.e. + 0.1%; pixels within [`pixel_tol`] for full-spectrum methods.
+/// `lighttrace`: exactly 0 from the water; from outside exactly 0 wherever the
+/// view is all sphere, the enclosure beside it 1.
 #[test]
 fn nested_dielectrics_follow_the_medium_stack() {
     let want = 1.33f64.powi(2);
-    for m in METHODS.into_iter().filter(|m| *m != "lighttrace") {
+    for m in METHODS {
         let film = render_str(&water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", 0, 0), &method(m, 16, 6));
+        if m == "lighttrace" {
+            // Seen through glass: exactly 0 inside; from outside only the enclosure around the spheres.
+            assert!(y(&film).iter().all(|&v| v == 0.0), "lighttrace: nothing through glass");
+            let film = render_str(&water_in_glass("(0, 0, 4)", "(0, 0, 0)", 0, 0), &method(m, 32, 7));
+            let cover =
+                sphere_cover(glam::Vec3::new(0.0, 0.0, 4.0), glam::Vec3::ZERO, 35.0, 8, &[(glam::Vec3::ZERO, 1.0)]);
+            lighttrace_sees_only_the_enclosure(&film, &cover, "water in glass from outside");
+            continue;
+        }
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("nested, camera in water, {m}: Y = {mean:.4} ± {se:.4} (want {want:.4}; without a stack 3.98)");
         assert!((mean - want).abs() < 5.0 * se + 1e-3 * want, "{m}: {mean} ± {se}");
@@ -55,8 +66,17 @@ fn nested_dielectrics_follow_the_medium_stack() {
 /// above, it sees 1.33² L. Two partially overlapping spheres (1.5 and
 /// 1.33, each priority order) are invisible from outside: every region
 /// holds one medium, so the enclosure is in equilibrium. Tolerances as above.
+/// `lighttrace` sees both concentric views through glass: exactly 0; the
+/// overlapping pair from outside: exactly 0 where the view is all sphere,
+/// the enclosure beside them 1.
 #[test]
 fn priority_decides_which_medium_fills_an_overlap() {
+    for (glass, water) in [(1, 0), (0, 1)] {
+        // Light tracing sees both inside views through glass: exactly 0.
+        let film =
+            render_str(&water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", glass, water), &method("lighttrace", 16, 8));
+        assert!(y(&film).iter().all(|&v| v == 0.0), "lighttrace, priorities {glass} {water}");
+    }
     for m in ["whitted", "path", "hero", "auto", "bdpt"] {
         for (glass, water, want) in [(1, 0, 2.25f64), (0, 1, 1.7689)] {
             let film = render_str(&water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", glass, water), &method(m, 16, 8));
@@ -77,6 +97,13 @@ fn priority_decides_which_medium_fills_an_overlap() {
                     {ENCLOSURE},
                 ])"#
             );
+            if m == "whitted" {
+                // Light tracing sees the spheres through glass: exactly 0 there, the enclosure beside them 1.
+                let film = render_str(&scene, &method("lighttrace", 32, 9));
+                let spheres = [(glam::Vec3::new(-0.35, 0.0, 0.0), 0.6), (glam::Vec3::new(0.35, 0.1, 0.1), 0.6)];
+                let cover = sphere_cover(glam::Vec3::new(0.0, 0.0, 4.0), glam::Vec3::ZERO, 40.0, 10, &spheres);
+                lighttrace_sees_only_the_enclosure(&film, &cover, &format!("overlapping spheres, priorities {a} {b}"));
+            }
             let film = render_str(&scene, &method(m, 32, 9));
             let (mean, se) = mean_and_stderr(&film, 1);
             assert!((mean - 1.0).abs() < 5.0 * se + 1e-3, "{m}, priorities {a} {b}: overlap visible: {mean} ± {se}");
@@ -99,6 +126,8 @@ fn priority_decides_which_medium_fills_an_overlap() {
 /// medium, so in the uniform enclosure it is invisible from every side
 /// (image mean within 5 s.e. + 0.2%; `whitted`, without roulette, per pixel
 /// within 1%).
+/// `lighttrace`: exactly 0 wherever the view is all block, the enclosure beside
+/// it 1.
 #[test]
 fn a_glass_of_water_is_invisible_in_a_furnace() {
     for (eye, seed) in [("(0.3, 0.9, 4)", 10), ("(0.2, 3.5, 1.5)", 11)] {
@@ -116,6 +145,21 @@ fn a_glass_of_water_is_invisible_in_a_furnace() {
                 {ENCLOSURE},
             ])"#
         );
+        // Light tracing: exactly 0 wherever the view is all glass block (or the
+        // vacuum block above it), the enclosure beside it 1.
+        let film = render_str(&scene, &method("lighttrace", 32, seed));
+        let (glass, vacuum) = (
+            (glam::Vec3::new(-0.5, 0.0, -0.5), glam::Vec3::new(0.5, 1.4, 0.5)),
+            (glam::Vec3::new(-0.44, 0.89, -0.44), glam::Vec3::new(0.44, 1.6, 0.44)),
+        );
+        let eye_v = {
+            let c: Vec<f32> = eye.trim_matches(['(', ')']).split(',').map(|x| x.trim().parse().unwrap()).collect();
+            glam::Vec3::new(c[0], c[1], c[2])
+        };
+        let cover = cover(eye_v, glam::Vec3::new(0.0, 0.6, 0.0), 35.0, 12, |r| {
+            hits_box(r, glass.0, glass.1) || hits_box(r, vacuum.0, vacuum.1)
+        });
+        lighttrace_sees_only_the_enclosure(&film, &cover, &format!("glass of water from {eye}"));
         for m in ["whitted", "path", "auto", "bdpt"] {
             let film = render_str(&scene, &method(m, 32, seed));
             let (mean, se) = mean_and_stderr(&film, 1);
@@ -190,11 +234,17 @@ fn absorption_follows_the_medium_a_segment_runs_in() {
 /// surface) leaves a medium it never entered, which refracts glass →
 /// vacuum: at near-normal incidence R + (1 − R) n² with R = 0.04, i.e. 2.2.
 /// Tolerances as in the tests above (1% for the quad: R varies over the 4° view).
+/// `lighttrace`: exactly 0 wherever glass is in view, the enclosure beside it
+/// 1.
 #[test]
 fn medium_stack_overflow_and_inconsistent_geometry() {
     let spheres: Vec<String> = (0..10)
         .map(|i| format!("(shape: Sphere(center: (0, 0, 0), radius: {}), material: \"glass\")", 1.0 - 0.08 * i as f64))
         .collect();
+    let parse = |v: &str| {
+        let c: Vec<f32> = v.trim_matches(['(', ')']).split(',').map(|x| x.trim().parse().unwrap()).collect();
+        glam::Vec3::new(c[0], c[1], c[2])
+    };
     for (eye, look_at, want) in [("(0, 0, 0)", "(0.3, 0.2, -1)", 2.25), ("(0, 0, 4)", "(0, 0, 0)", 1.0)] {
         let scene = format!(
             r#"(camera: (eye: {eye}, look_at: {look_at}, fov_deg: 35), render: (width: 8, height: 8, max_bounces: 64),
@@ -202,6 +252,9 @@ fn medium_stack_overflow_and_inconsistent_geometry() {
             objects: [ {}, {ENCLOSURE} ])"#,
             spheres.join(", ")
         );
+        let film = render_str(&scene, &method("lighttrace", 16, 14));
+        let cover = sphere_cover(parse(eye), parse(look_at), 35.0, 8, &[(glam::Vec3::ZERO, 1.0)]);
+        lighttrace_sees_only_the_enclosure(&film, &cover, &format!("ten nested spheres from {eye}"));
         for m in ["whitted", "path", "auto", "bdpt"] {
             let film = render_str(&scene, &method(m, 16, 14));
             let (mean, se) = mean_and_stderr(&film, 1);
@@ -214,6 +267,8 @@ fn medium_stack_overflow_and_inconsistent_geometry() {
         materials: {{ "glass": Dielectric(ior: Constant(1.5)) }},
         objects: [ (shape: Quad(origin: (-1, -1, 0), edge_u: (2, 0, 0), edge_v: (0, 2, 0)), material: "glass"), {ENCLOSURE} ])"#
     );
+    // Light tracing sees the enclosure only through the quad: exactly 0.
+    assert!(y(&render_str(&quad, &method("lighttrace", 16, 15))).iter().all(|&v| v == 0.0), "lighttrace, quad");
     for m in ["whitted", "path", "auto", "bdpt"] {
         let film = render_str(&quad, &method(m, 64, 15));
         let (mean, se) = mean_and_stderr(&film, 1);
@@ -231,6 +286,8 @@ fn medium_stack_overflow_and_inconsistent_geometry() {
 /// the full weight (with an MIS weight below 1 there, `path` gave an image
 /// mean of 0.937 ± 0.010).
 /// Image mean within 5 s.e. + 0.2%.
+/// `lighttrace` (1024 spp) too: the ball is diffuse, and its eye connections
+/// pass the false intersections.
 #[test]
 fn a_false_intersection_leaves_the_emitter_to_bsdf_sampling() {
     let scene = r#"(camera: (eye: (-0.3, 0, 0), look_at: (0.2, 0, 0), fov_deg: 50), render: (width: 8, height: 8, max_bounces: 64),
@@ -242,8 +299,8 @@ fn a_false_intersection_leaves_the_emitter_to_bsdf_sampling() {
             (shape: Sphere(center: (0.2, 0, 0), radius: 0.15), material: "white"),
             (shape: Sphere(center: (0, 0, 0), radius: 1.5), emission: Constant(1), two_sided: true),
         ])"#;
-    for m in ["path", "hero", "auto", "bdpt"] {
-        let film = render_str(scene, &method(m, 64, 16));
+    for m in ["path", "hero", "auto", "bdpt", "lighttrace"] {
+        let film = render_str(scene, &method(m, if m == "lighttrace" { 1024 } else { 64 }, 16));
         let (mean, se) = mean_and_stderr(&film, 1);
         eprintln!("white ball past a false intersection, {m}: Y = {mean:.4} ± {se:.4}, want 1");
         assert!((mean - 1.0).abs() < 5.0 * se + 2e-3, "{m}: {mean} ± {se}");
@@ -257,6 +314,7 @@ fn a_false_intersection_leaves_the_emitter_to_bsdf_sampling() {
 /// 589.3 nm) n_w(589.3)². Using the glass's index at the wrong wavelength
 /// would leave a factor (n_g(λ)/n_g(589.3))², up to ±2% per bin.
 /// Image mean within 5 s.e. + 0.1%.
+/// `lighttrace`: exactly 0 (seen through glass).
 #[test]
 fn dispersive_water_in_dispersive_glass() {
     let scene = format!(
@@ -273,6 +331,8 @@ fn dispersive_water_in_dispersive_glass() {
     let spectral: f64 =
         (0..36).map(|b| (water.at(rust_v::color::bin_lambda_nm(b)) as f64).powi(2) * cmf[b][1] as f64).sum();
     let reference = (water.at(589.3) as f64).powi(2);
+    // Light tracing: everything through glass, exactly 0.
+    assert!(y(&render_str(&scene, &method("lighttrace", 16, 17))).iter().all(|&v| v == 0.0), "lighttrace");
     for m in ["path", "hero", "auto", "bdpt"] {
         let film = render_str(&scene, &method(m, 32, 17));
         let (mean, se) = mean_and_stderr(&film, 1);

@@ -91,6 +91,9 @@ mod mis;
 mod vertex;
 mod walk;
 
+#[cfg(test)]
+mod tests;
+
 use std::cell::RefCell;
 
 use glam::{Vec2, Vec3};
