@@ -425,3 +425,31 @@ fn inline_mesh_uvs_are_interpolated_at_hits() {
     }
     assert!(differs, "without uvs the default per-triangle mapping applies");
 }
+
+/// Texture coordinates come from mesh files: OBJ `vt` and PLY `s t` / `u v` /
+/// `texture_u texture_v` columns, interpolated at hits like inline `uvs`. The
+/// same square as in `inline_mesh_uvs_are_interpolated_at_hits`, with uvs
+/// `((x + 1) / 2, (y + 1) / 2)` at its corners, in each format.
+#[test]
+fn mesh_files_bring_their_texture_coordinates() {
+    let dir = temp_dir("mesh-uvs");
+    let obj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    std::fs::write(dir.join("sq.obj"), obj).unwrap();
+    for (name, u, v) in [("st", "s", "t"), ("uv", "u", "v"), ("tex", "texture_u", "texture_v")] {
+        let ply = format!(
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float {u}\nproperty float {v}\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n-1 -1 0 0 0\n1 -1 0 1 0\n1 1 0 1 1\n-1 1 0 0 1\n3 0 1 2\n3 0 2 3\n"
+        );
+        std::fs::write(dir.join(format!("sq-{name}.ply")), ply).unwrap();
+    }
+    for file in ["sq.obj", "sq-st.ply", "sq-uv.ply", "sq-tex.ply"] {
+        let text = one_object(&format!(r#"(shape: Mesh(path: "{file}"), material: "white")"#));
+        let scene = load_scene_str(&text, &dir.join("t.ron"), &Default::default()).unwrap_or_else(|e| panic!("{e}"));
+        for (x, y) in [(0.5f32, -0.25f32), (-0.6, 0.7), (0.1, 0.05)] {
+            let ray = Ray::new(Vec3::new(x, y, 3.0), Vec3::new(0.0, 0.0, -1.0));
+            let si = scene.intersect(&ray, f32::INFINITY).expect("hits the square");
+            let uv = scene.uv(&si);
+            let want = glam::Vec2::new((x + 1.0) / 2.0, (y + 1.0) / 2.0);
+            assert!((uv - want).abs().max_element() < 1e-5, "{file} ({x}, {y}): {uv} want {want}");
+        }
+    }
+}

@@ -30,7 +30,7 @@ pub fn parse_mesh(raw: Vec<u8>, path: &Path) -> Result<MeshData> {
     };
     if name.ends_with(".ply") {
         let d = ply::parse(&data, path)?;
-        Ok(MeshData { positions: d.positions, triangles: d.triangles, normals: d.normals })
+        Ok(MeshData { positions: d.positions, triangles: d.triangles, normals: d.normals, uvs: d.uvs })
     } else if name.ends_with(".obj") {
         load_obj(&data, path)
     } else {
@@ -47,6 +47,10 @@ pub struct MeshData {
     pub triangles: Vec<[u32; 3]>,
     /// Per-vertex normals, when the file has one for every vertex.
     pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, when the file has them for every vertex
+    /// (OBJ `vt`; PLY `u v`, `s t`, `texture_u texture_v` or `texture_s texture_t`),
+    /// as the file gives them (no flip).
+    pub uvs: Option<Vec<[f32; 2]>>,
 }
 
 /// Reads an OBJ file (all its objects and groups merged) with tobj, triangulated, with
@@ -65,6 +69,8 @@ fn load_obj(data: &[u8], path: &Path) -> Result<MeshData> {
     let mut indices = Vec::new();
     let mut normals = Vec::new();
     let mut all_normals = true;
+    let mut uvs = Vec::new();
+    let mut all_uvs = true;
     for model in &models {
         let m = &model.mesh;
         let base = positions.len() as u32;
@@ -74,6 +80,11 @@ fn load_obj(data: &[u8], path: &Path) -> Result<MeshData> {
             normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         } else {
             all_normals = false;
+        }
+        if m.texcoords.len() == 2 * nv {
+            uvs.extend(m.texcoords.chunks_exact(2).map(|c| [c[0], c[1]]));
+        } else {
+            all_uvs = false;
         }
         if m.indices.len() % 3 != 0 {
             return Err(Error::mesh(
@@ -92,5 +103,6 @@ fn load_obj(data: &[u8], path: &Path) -> Result<MeshData> {
         }
     }
     let normals = (all_normals && !normals.is_empty()).then_some(normals);
-    Ok(MeshData { positions, triangles: indices, normals })
+    let uvs = (all_uvs && !uvs.is_empty()).then_some(uvs);
+    Ok(MeshData { positions, triangles: indices, normals, uvs })
 }

@@ -12,6 +12,7 @@ pub(crate) struct PlyData {
     pub positions: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
     pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<[f32; 2]>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,6 +86,7 @@ enum Format {
 struct Layout {
     xyz: [usize; 3],
     normal: Option<[usize; 3]>,
+    uv: Option<[usize; 2]>,
     face_list: usize,
 }
 
@@ -109,6 +111,11 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
         (Some(a), Some(b), Some(c)) => Some([a, b, c]),
         _ => None,
     };
+    // Texture coordinates under the names PLY writers use (Blender and MeshLab:
+    // `s t`; others `u v`, `texture_u texture_v`, `texture_s texture_t`).
+    let uv = [["u", "v"], ["s", "t"], ["texture_u", "texture_v"], ["texture_s", "texture_t"]]
+        .iter()
+        .find_map(|[a, b]| Some([find(ve, a)?, find(ve, b)?]));
     let fe = &elements[fi];
     let face_list = fe
         .props
@@ -120,7 +127,7 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
     {
         return Err(err("PLY face list must have integer count and index types".into()));
     }
-    let layout = Layout { xyz, normal, face_list };
+    let layout = Layout { xyz, normal, uv, face_list };
     // The header can claim any count: reserve no more than the body can hold (every
     // element takes at least one byte), or a corrupt count aborts on allocation.
     let (nv, nf) = (ve.count.min(body.len()), fe.count.min(body.len()));
@@ -128,6 +135,7 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
         positions: Vec::with_capacity(nv),
         triangles: Vec::with_capacity(nf * 2),
         normals: normal.map(|_| Vec::with_capacity(nv)),
+        uvs: uv.map(|_| Vec::with_capacity(nv)),
     };
     match format {
         Format::Ascii => read_ascii(body, header_lines, &elements, vi, fi, &layout, &mut out, path)?,
@@ -297,6 +305,9 @@ fn push_vertex(out: &mut PlyData, layout: &Layout, val: impl Fn(usize) -> f64) {
     out.positions.push(Vec3::new(val(x) as f32, val(y) as f32, val(z) as f32));
     if let (Some(ns), Some([a, b, c])) = (out.normals.as_mut(), layout.normal) {
         ns.push(Vec3::new(val(a) as f32, val(b) as f32, val(c) as f32));
+    }
+    if let (Some(uvs), Some([u, v])) = (out.uvs.as_mut(), layout.uv) {
+        uvs.push([val(u) as f32, val(v) as f32]);
     }
 }
 

@@ -90,20 +90,20 @@ impl Mesh {
         transform: &Transform,
         then: Option<&Transform>,
     ) -> Result<Mesh> {
-        Mesh::from_parts(data, None, transform, then, &|m| Error::mesh(path, m))
+        Mesh::from_parts(data, transform, then, &|m| Error::mesh(path, m))
     }
 
-    /// A mesh from parsed contents (a file's or an inline description's) and optional
-    /// per-vertex `uvs` (one per position: the caller checks), placed by `transform`
-    /// then `then`; `err` makes the errors about the contents.
+    /// A mesh from parsed contents (a file's or an inline description's, with
+    /// optional per-vertex normals and `uvs`: one per position, the caller
+    /// checks), placed by `transform` then `then`; `err` makes the errors about
+    /// the contents.
     pub(crate) fn from_parts(
         data: MeshData,
-        uvs: Option<Vec<[f32; 2]>>,
         transform: &Transform,
         then: Option<&Transform>,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
-        let MeshData { positions, triangles, normals } = data;
+        let MeshData { positions, triangles, normals, uvs } = data;
         Mesh::build(positions, triangles, normals, uvs, transform, then, err)
     }
 
@@ -628,8 +628,9 @@ mod tests {
         // A square whose uvs are its (x, y): the uv at any hit is the hit's (x, y).
         let pos = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
         let uvs = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        let data = MeshData { positions: pos.clone(), triangles: vec![[0, 1, 2], [0, 2, 3]], normals: None };
-        let m = Mesh::from_parts(data, Some(uvs), &Transform::default(), None, &Error::Settings).unwrap();
+        let data =
+            MeshData { positions: pos.clone(), triangles: vec![[0, 1, 2], [0, 2, 3]], normals: None, uvs: Some(uvs) };
+        let m = Mesh::from_parts(data, &Transform::default(), None, &Error::Settings).unwrap();
         let mut rng = Pcg32::new(5, 1);
         for _ in 0..200 {
             let (x, y) = (uniform(&mut rng), uniform(&mut rng));

@@ -13,7 +13,7 @@
 //! | `Disk` | angle `φ / 2π` about the normal, from the tangent of `Frame::from_z(normal)` | radius `r / radius`: 0 at the centre, 1 on the rim |
 //! | `Cuboid` | on a face perpendicular to axis `k`: the position along axis `(k + 1) mod 3`, over the box's extent | along axis `(k + 2) mod 3` (x faces: (y, z); y faces: (z, x); z faces: (x, y)) |
 //! | `Plane` | distance along the tangent of `Frame::from_z(normal)` from `point`, in scene units (not wrapped) | along the bitangent |
-//! | `Mesh` | the per-vertex texture coordinates interpolated, when the mesh has them (inline `Triangles(uvs: ...)`; OBJ `vt` and PLY uv are not read yet); else pbrt's default per triangle, (0, 0), (1, 0), (1, 1) at its three vertices | as u |
+//! | `Mesh` | the per-vertex texture coordinates interpolated, when the mesh has them (inline `Triangles(uvs: ...)`, OBJ `vt`, PLY `s t`, `u v`, `texture_u texture_v` or `texture_s texture_t`); else pbrt's default per triangle, (0, 0), (1, 0), (1, 1) at its three vertices | as u |
 //!
 //! A mesh hit's barycentric coordinates are recovered from the hit point and
 //! the triangle's vertices (the hit record does not carry them).
