@@ -321,7 +321,11 @@ fn bad_transforms_name_the_field() {
     for (shape, transform, field, message) in cases {
         let text = one_object(&format!(r#"(shape: {shape}, material: "glass", transform: ({transform}))"#));
         let e = load_scene_str(&text, Path::new("t.ron"), &Default::default()).unwrap_err().to_string();
-        assert!(e.contains(&format!("t.ron: {field}: ")) && e.contains(message), "{transform}: {e}");
+        // `t.ron:LINE:COL: field: message` (the position of the field in the text).
+        assert!(
+            e.starts_with("t.ron:") && e.contains(&format!(": {field}: ")) && e.contains(message),
+            "{transform}: {e}"
+        );
     }
     // A misspelt part is a parse error with its position.
     let text = one_object(
@@ -398,7 +402,7 @@ fn bad_inline_meshes_name_the_field() {
     for (body, field, message) in cases {
         let text = one_object(&format!(r#"(shape: Triangles({body}), material: "white")"#));
         let e = load_scene_str(&text, Path::new("t.ron"), &Default::default()).unwrap_err().to_string();
-        assert!(e.contains(&format!("t.ron: {field}: ")) && e.contains(message), "{body}: {e}");
+        assert!(e.starts_with("t.ron:") && e.contains(&format!(": {field}: ")) && e.contains(message), "{body}: {e}");
     }
 }
 
@@ -452,4 +456,18 @@ fn mesh_files_bring_their_texture_coordinates() {
             assert!((uv - want).abs().max_element() < 1e-5, "{file} ({x}, {y}): {uv} want {want}");
         }
     }
+}
+
+/// Errors found while building the scene (after parsing) name the line and
+/// column of the field as well as its path: here the `radius:` of the second
+/// object, on line 6, column 24, and a missing material at the first object's
+/// opening parenthesis (line 4, column 9).
+#[test]
+fn build_errors_carry_the_field_s_position() {
+    let text = "(\n    camera: (eye: (0, 1, 4), look_at: (0, 0, 0), fov_deg: 40),\n    objects: [\n        (shape: Sphere(center: (0, 0, 0), radius: 1), material: \"white\"),\n        (shape: Sphere(center: (0, 0, 0),\n                       radius: -1), material: \"white\"),\n    ],\n    materials: { \"white\": Lambertian(reflectance: Constant(0.5)) },\n)\n";
+    let e = load_scene_str(text, Path::new("p.ron"), &Default::default()).unwrap_err().to_string();
+    assert!(e.starts_with("p.ron:6:24: objects[1].shape.radius: "), "{e}");
+    let text = text.replace("radius: -1), material: \"white\"", "radius: 1)").replacen(", material: \"white\"", "", 1);
+    let e = load_scene_str(&text, Path::new("p.ron"), &Default::default()).unwrap_err().to_string();
+    assert!(e.starts_with("p.ron:4:9: objects[0]"), "{e}");
 }

@@ -53,7 +53,7 @@ fn load(text: &str, bytes: &[u8], path: &Path, overrides: &SettingsPatch) -> Res
         }
     })?;
     let ctx = Check::new(path);
-    let mut scene = build(&ctx, desc, overrides)?;
+    let mut scene = build(&ctx, desc, overrides).map_err(|e| locate(e, text))?;
     let inputs = ctx.inputs.into_inner();
     scene.content_hash = content_hash(bytes, &inputs);
     scene.inputs = inputs.into_iter().map(|i| i.path).collect();
@@ -99,6 +99,19 @@ fn decode_text<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str> {
         return Err(at(skipped + offset, "a NUL byte (UTF-16 or binary data?); expected UTF-8 text".into()));
     }
     Ok(text)
+}
+
+/// Adds to a scene error found while building (a field path, no position) the
+/// line and column in `text` of the place the path names
+/// ([`super::position`]): `scene.ron:12:9: objects[3].shape.radius: ...`.
+fn locate(e: Error, text: &str) -> Error {
+    match e {
+        Error::Scene { path, position: None, field, message } if !field.is_empty() => {
+            let position = super::position::offset_of(text, &field).map(|o| line_col(&text.as_bytes()[..o]));
+            Error::Scene { path, position, field, message }
+        }
+        e => e,
+    }
 }
 
 /// 1-based line and column (in characters) just after `before`.

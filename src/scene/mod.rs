@@ -10,6 +10,7 @@
 pub(crate) mod check;
 pub mod desc;
 mod load;
+mod position;
 mod query;
 mod spectra;
 
