@@ -9,11 +9,13 @@ mod bounds;
 mod frame;
 mod hit;
 mod ray;
+mod transform;
 
 pub use bounds::Aabb;
 pub use frame::Frame;
 pub use hit::Hit;
 pub use ray::{Ray, offset_ray_origin};
+pub use transform::Transform;
 
 /// Half the f32 machine epsilon (the unit roundoff u = 2^-24).
 pub const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;

@@ -19,8 +19,8 @@ use glam::Vec3;
 
 use super::desc::{ScaleDesc, V3};
 use crate::error::{Error, Result};
+use crate::geometry::Transform;
 use crate::io::{fnv1a, read_input};
-use crate::shape::Transform;
 
 /// The largest coordinate or size a scene may give: squares and products of a few
 /// such numbers must stay finite in f32 (max 3.4e38), or intersections and light

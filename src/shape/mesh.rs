@@ -9,46 +9,12 @@ use crate::scene::check::Check;
 use crate::scene::desc::{ScaleDesc, V3};
 use std::path::Path;
 
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 
 use super::bvh::{MAX_BLOCKS, TriangleHit, WideBvh};
 use crate::error::{Error, Result};
-use crate::geometry::{Aabb, Hit, Ray};
+use crate::geometry::{Aabb, Hit, Ray, Transform};
 use crate::io::{MeshData, read_mesh_file};
-
-/// Placement of a mesh: scale, then rotate about X, then Y, then Z (degrees), then
-/// translate. The default is the identity.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Transform {
-    /// Per-axis scale (applied first).
-    pub scale: Vec3,
-    /// Rotation angles in degrees about X, Y and Z, applied in that order.
-    pub rotate_deg: Vec3,
-    /// Translation (applied last).
-    pub translate: Vec3,
-}
-
-impl Default for Transform {
-    fn default() -> Self {
-        Transform { scale: Vec3::ONE, rotate_deg: Vec3::ZERO, translate: Vec3::ZERO }
-    }
-}
-
-impl Transform {
-    /// The linear part: `Rz * Ry * Rx * S`.
-    pub fn linear(&self) -> Mat3 {
-        let r = self.rotate_deg * (std::f32::consts::PI / 180.0);
-        Mat3::from_rotation_z(r.z)
-            * Mat3::from_rotation_y(r.y)
-            * Mat3::from_rotation_x(r.x)
-            * Mat3::from_diagonal(self.scale)
-    }
-
-    /// Transforms a point.
-    pub fn point(&self, p: Vec3) -> Vec3 {
-        self.linear() * p + self.translate
-    }
-}
 
 /// A triangle mesh with optional per-vertex normals and its own BVH.
 #[derive(Clone, Debug)]

@@ -24,12 +24,13 @@ mod sphere;
 mod triangle;
 mod uv;
 
+pub use crate::geometry::Transform;
 pub use batch::Batch;
 pub use bubble::Bubble;
 pub use bvh::{Bvh, TriangleHit, WideBvh};
 pub use cuboid::Cuboid;
 pub use disk::Disk;
-pub use mesh::{Mesh, Transform};
+pub use mesh::Mesh;
 pub use plane::Plane;
 pub use quad::Quad;
 pub use sphere::Sphere;
