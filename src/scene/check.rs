@@ -69,6 +69,12 @@ impl Check<'_> {
         Ok((path, bytes))
     }
 
+    /// Records a file read elsewhere (a mesh read ahead on the thread pool, see
+    /// `Mesh::read_ahead`) in the scene's identity, as [`Check::read_input`] does.
+    pub(crate) fn record_input(&self, rel: &str, path: PathBuf, hash: u64) {
+        self.inputs.borrow_mut().push(Input { name: rel.to_string(), path, hash });
+    }
+
     /// A finite number in (0, [`MAX_MAGNITUDE`]].
     pub(crate) fn positive(&self, field: &str, v: f32) -> Result<f32> {
         if v.is_finite() && v > 0.0 && v <= MAX_MAGNITUDE {

@@ -6,19 +6,22 @@
 //! the field path (for checks after parsing) and what was expected.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
 
 use super::check::{Check, Input};
-use super::desc::SceneDesc;
+use super::desc::{SceneDesc, ShapeDesc};
 use super::{Object, Scene};
 use crate::bxdf::Bxdf;
 use crate::camera::Camera;
 use crate::error::{Error, Result};
+use crate::geometry::Transform;
 use crate::io::{Fnv1a, fnv1a, read_input};
 use crate::light::Light;
 use crate::material;
 use crate::settings::{Settings, SettingsPatch};
-use crate::shape::{Placement, Shape};
+use crate::shape::{Mesh, MeshAhead, Placement, Shape};
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
 /// precedence over the file's `render` settings. The file must be a regular
@@ -147,6 +150,29 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         materials.push(material::from_desc(ctx, &format!("materials.\"{name}\""), m)?);
     }
 
+    // Every mesh file is read, parsed and built (with its BVH) at once on the
+    // thread pool; the loop below takes them in object order, so the scene,
+    // its identity and the first error are those of loading one by one. A mesh
+    // whose transform is invalid is left to the loop, which reports it.
+    let jobs: Vec<(usize, PathBuf, Transform, Option<Transform>)> = desc
+        .objects
+        .iter()
+        .enumerate()
+        .filter_map(|(i, o)| {
+            let ShapeDesc::Mesh { path, scale, rotate_deg, translate } = &o.shape else { return None };
+            let own = ctx.transform(&format!("objects[{i}].shape"), scale, rotate_deg, translate).ok()?;
+            let then = match &o.transform {
+                None => None,
+                Some(t) => Some(
+                    ctx.transform(&format!("objects[{i}].transform"), &t.scale, &t.rotate_deg, &t.translate).ok()?,
+                ),
+            };
+            Some((i, ctx.dir.join(path), own, then))
+        })
+        .collect();
+    let mut ahead: BTreeMap<usize, MeshAhead> =
+        jobs.into_par_iter().map(|(i, path, own, then)| (i, Mesh::read_ahead(path, &own, then.as_ref()))).collect();
+
     let mut objects = Vec::with_capacity(desc.objects.len());
     let mut lights = Vec::new();
     for (i, o) in desc.objects.iter().enumerate() {
@@ -158,7 +184,12 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
                 Some(Placement { t: ctx.transform(&tf, &t.scale, &t.rotate_deg, &t.translate)?, field: tf })
             }
         };
-        let shape = Shape::from_desc(ctx, &format!("{field}.shape"), &o.shape, xf.as_ref())?;
+        let shape = match (&o.shape, ahead.remove(&i)) {
+            (ShapeDesc::Mesh { path, .. }, Some(a)) => {
+                Shape::Mesh(Box::new(Mesh::from_ahead(ctx, &format!("{field}.shape"), path, a, xf.as_ref())?))
+            }
+            (shape, _) => Shape::from_desc(ctx, &format!("{field}.shape"), shape, xf.as_ref())?,
+        };
         let material = match &o.material {
             Some(name) => *by_name.get(name.as_str()).ok_or_else(|| {
                 let known: Vec<&str> = by_name.keys().copied().collect();

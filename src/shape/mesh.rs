@@ -4,10 +4,10 @@
 //! order); `Hit::prim` is a triangle's index in that order (its slot).
 
 use super::Placement;
-use crate::io::parse_mesh;
+use crate::io::{fnv1a, parse_mesh, read_input};
 use crate::scene::check::Check;
 use crate::scene::desc::{ScaleDesc, V3};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
@@ -15,6 +15,14 @@ use super::bvh::{MAX_BLOCKS, TriangleHit, WideBvh};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, Hit, Ray, Transform};
 use crate::io::{MeshData, read_mesh_file};
+
+/// A mesh file read, parsed and built ahead of the scene's other objects
+/// ([`Mesh::read_ahead`]): the file's path, and its content's hash with the
+/// built mesh, or the read's error.
+pub(crate) struct MeshAhead {
+    path: PathBuf,
+    read: Result<(u64, Result<Mesh>)>,
+}
 
 /// A triangle mesh with optional per-vertex normals and its own BVH.
 #[derive(Clone, Debug)]
@@ -321,11 +329,38 @@ impl Mesh {
         translate: &Option<V3>,
         xf: Option<&Placement>,
     ) -> Result<Mesh> {
-        let f = |name: &str| format!("{field}.{name}");
         let transform = check.transform(field, scale, rotate_deg, translate)?;
-        let (file, bytes) = check.read_input(&f("path"), path)?;
-        let data = parse_mesh(bytes, &file).map_err(|e| check.err(f("path"), e.to_string()))?;
-        Mesh::from_data_placed(data, &file, &transform, xf.map(|x| &x.t)).map_err(|e| match (e, xf) {
+        let ahead = Mesh::read_ahead(check.dir.join(path), &transform, xf.map(|x| &x.t));
+        Mesh::from_ahead(check, field, path, ahead, xf)
+    }
+
+    /// Reads, parses and builds the mesh file at `path` placed by `transform`
+    /// then `then`, without a [`Check`]: the scene loader calls it for every
+    /// mesh of a scene at once on the thread pool, then [`Mesh::from_ahead`] in
+    /// object order. The result (and the mesh's BVH) does not depend on the
+    /// thread that made it.
+    pub(crate) fn read_ahead(path: PathBuf, transform: &Transform, then: Option<&Transform>) -> MeshAhead {
+        let read = read_input(&path).map(|bytes| {
+            let hash = fnv1a(&bytes);
+            (hash, parse_mesh(bytes, &path).and_then(|data| Mesh::from_data_placed(data, &path, transform, then)))
+        });
+        MeshAhead { path, read }
+    }
+
+    /// The mesh of field `field` (`rel`: the file as the scene names it) from
+    /// what [`Mesh::read_ahead`] made: records the file in the scene's identity
+    /// and names the field in any error, exactly as reading it here would.
+    pub(crate) fn from_ahead(
+        check: &Check,
+        field: &str,
+        rel: &str,
+        ahead: MeshAhead,
+        xf: Option<&Placement>,
+    ) -> Result<Mesh> {
+        let f = |name: &str| format!("{field}.{name}");
+        let (hash, built) = ahead.read.map_err(|e| check.err(f("path"), e.to_string()))?;
+        check.record_input(rel, ahead.path, hash);
+        built.map_err(|e| match (e, xf) {
             // A transform that breaks the composed placement is the object's when it has one.
             (Error::Setting { name, message }, Some(x)) => check.err(format!("{}.{name}", x.field), message),
             (Error::Setting { name, message }, None) => check.err(f(name), message),

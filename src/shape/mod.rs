@@ -31,6 +31,7 @@ pub use bvh::{Bvh, TriangleHit, WideBvh};
 pub use cuboid::Cuboid;
 pub use disk::Disk;
 pub use mesh::Mesh;
+pub(crate) use mesh::MeshAhead;
 pub use plane::Plane;
 pub use quad::Quad;
 pub use sphere::Sphere;
