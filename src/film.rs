@@ -25,7 +25,7 @@
 //!   anything an f32 EXR or a 16-bit PNG can show.
 //! - Samples are clamped to `±`[`MAX_SAMPLE`] = 2^31 (≈ 2.1e9, a billion
 //!   times a bright light: a light that bright, or a bug) and counted apart
-//!   from non-finite samples, which are dropped ([`Faults`]).
+//!   from non-finite samples, which are dropped (`Faults`).
 //!   With that bound, even `u32::MAX` passes cannot overflow an `i128`
 //!   ((2^32 − 1) · 2^31 · 2^64 < 2^127), so every sum is exact.
 //!
