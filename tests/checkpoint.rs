@@ -35,6 +35,7 @@ fn meta(scene: &Scene, film: Film) -> Checkpoint {
         target_end: 100,
         output: "/tmp/x.png".into(),
         film,
+        inputs: Some(scene.input_hashes.clone()),
     }
 }
 

@@ -452,38 +452,79 @@ fn resume_and_merge_refuse_changed_meshes() {
     std::thread::sleep(Duration::from_millis(50));
     std::fs::write(&mesh, TRI_OBJ.replace("v 0 1 0", "v 0 0.9 0")).unwrap();
     let b = part("b", "1..2");
-    // The changed input is named (issue 34 item 16): the mesh, modified after the checkpoint.
+    // The changed input is named (issue 34 item 16): the mesh, by its own hash.
     let e = one_error(&run(&["resume", s(&a), "-q"]), 1);
-    assert!(e.contains("changed") && e.contains("mesh"), "{e}");
-    assert!(e.contains(&format!("{} modified after it", s(&mesh))), "{e}");
+    assert!(e.contains(&format!(": {} changed since the checkpoint was written", s(&mesh))), "{e}");
     // (To another checkpoint: a finished resume updates the one it writes.)
     let o = run(&["resume", s(&a), "-q", "--force", "--checkpoint", s(&d.join("forced.ckpt"))]);
     assert!(o.status.success() && stderr(&o).contains("warning"), "{}", stderr(&o));
-    assert!(stderr(&o).contains(&format!("{} modified after it", s(&mesh))), "{}", stderr(&o));
+    assert!(stderr(&o).contains(&format!("{} changed since", s(&mesh))), "{}", stderr(&o));
     let e = one_error(&run(&["merge", s(&a), s(&b), "-o", s(&d.join("m.png"))]), 1);
     assert!(e.contains("different scene"), "{e}");
     // A spectrum file is an input too.
     std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.8\n").unwrap();
     std::fs::write(&scene, SCENE.replace("Constant(0.5)", "File(\"refl.csv\")")).unwrap();
     let c = part("c", "0..1");
+    // The same as version 3 (before per-input hashes): one hash over all inputs.
+    let c3 = d.join("c3.ckpt");
+    let mut old_version = rust_v::checkpoint::Checkpoint::read(&c).unwrap();
+    old_version.inputs = None;
+    old_version.write(&c3).unwrap();
+    assert_eq!(std::fs::read(&c3).unwrap()[8], 3, "written as version 3");
     std::thread::sleep(Duration::from_millis(50));
     std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.7\n").unwrap();
     let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
-    assert!(e.contains("changed") && e.contains("refl.csv modified after it"), "{e}");
-    // When no input is newer than the checkpoint, every input is named as possibly changed
-    // (the checkpoint keeps one hash over them all).
+    assert!(e.contains(&format!(": {} changed since", s(&d.join("refl.csv")))), "{e}");
+    // A checkpoint of version 3 keeps one hash over all inputs: the inputs modified after
+    // it are named, and when none is, every input is named as possibly changed.
+    let e = one_error(&run(&["resume", s(&c3), "-q", "--spp", "2"]), 1);
+    assert!(e.contains("refl.csv modified after it"), "{e}");
     let old = std::time::SystemTime::UNIX_EPOCH + Duration::from_secs(1_000_000_000);
     for f in [d.join("refl.csv"), scene.clone()] {
         std::fs::File::options().write(true).open(&f).unwrap().set_modified(old).unwrap();
     }
-    let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
+    let e = one_error(&run(&["resume", s(&c3), "-q", "--spp", "2"]), 1);
     assert!(e.contains("refl.csv") && e.contains("which is not known"), "{e}");
+    // It still resumes (--force), and the resumed checkpoint gains each input's hash.
+    let o = run(&["resume", s(&c3), "-q", "--force", "--spp", "2", "-o", s(&d.join("c3.png"))]);
+    assert!(o.status.success() && stderr(&o).contains("which is not known"), "{}", stderr(&o));
+    let resumed = rust_v::checkpoint::Checkpoint::read(&c3).unwrap();
+    assert_eq!((std::fs::read(&c3).unwrap()[8], resumed.passes()), (5, 0..2));
     // A scene that reads no other file: the scene file itself changed.
     std::fs::write(&scene, SCENE).unwrap();
     let plain = part("plain", "0..1");
     std::fs::write(&scene, SCENE.replace("Constant(0.5)", "Constant(0.6)")).unwrap();
     let e = one_error(&run(&["resume", s(&plain), "-q"]), 1);
     assert!(e.contains(&format!("the scene file {} changed", s(&scene))), "{e}");
+}
+
+/// Of two inputs that were both written after the checkpoint (as a checkout or a copy
+/// does), only the one whose bytes changed is named, by `resume` and by `resume --force`
+/// (issue 34 item 16: with one hash over all inputs, both were named by modification time).
+#[test]
+fn resume_names_exactly_the_changed_input() {
+    let d = temp_dir("hostile-which-input");
+    let scene = scene_in(&d, &MESH_SCENE.replace("Constant(0.5)", "File(\"refl.csv\")"));
+    let (mesh, csv) = (d.join("tri.obj"), d.join("refl.csv"));
+    std::fs::write(&mesh, TRI_OBJ).unwrap();
+    std::fs::write(&csv, "400,0.2\n700,0.8\n").unwrap();
+    let ck = d.join("a.ckpt");
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("a.png")), "--checkpoint", s(&ck), "--passes", "0..1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::thread::sleep(Duration::from_millis(50));
+    std::fs::write(&mesh, TRI_OBJ.replace("v 0 1 0", "v 0 0.9 0")).unwrap();
+    std::fs::write(&csv, "400,0.2\n700,0.8\n").unwrap();
+    std::fs::write(&scene, std::fs::read(&scene).unwrap()).unwrap();
+    let e = one_error(&run(&["resume", s(&ck), "-q"]), 1);
+    assert!(e.contains(&format!(": {} changed since the checkpoint was written (", s(&mesh))), "{e}");
+    assert!(!e.contains("refl.csv") && !e.contains("scene.ron ") && !e.contains("scene file"), "{e}");
+    let o = run(&["resume", s(&ck), "-q", "--force", "-o", s(&d.join("b.png"))]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains(&format!("{} changed since", s(&mesh))) && !err.contains("refl.csv"), "{err}");
+    // The forced resume recorded the new inputs: resuming again is not refused.
+    let o = run(&["resume", s(&ck), "-q", "--spp", "2", "-o", s(&d.join("c.png"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 // ---------------------------------------------------------------------------

@@ -87,6 +87,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         } else {
             Film::starting_at(s.width, s.height, passes.start)
         },
+        inputs: Some(scene.input_hashes.clone()),
     };
     checkpoint.film.set_color_space(args.color_space);
     let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, args.time);
@@ -119,21 +120,29 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     ckpt.film.set_color_space(args.color_space);
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?;
-    if scene.content_hash != ckpt.content_hash && args.force {
-        warn(format_args!("{}; resuming anyway (--force)", changed_inputs(path, &ckpt.scene_path, &scene.inputs)));
+    if scene.content_hash != ckpt.content_hash {
+        let changed = match &ckpt.inputs {
+            Some(old) => {
+                let names = rust_v::checkpoint::changed_inputs(old, &scene.input_hashes, &ckpt.scene_path);
+                format!("{} changed since the checkpoint was written", names.join(", "))
+            }
+            None => changed_inputs(path, &ckpt.scene_path, &scene.inputs),
+        };
+        if !args.force {
+            return Err(Error::checkpoint(
+                path,
+                format!(
+                    "{changed} (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
+                    scene.content_hash, ckpt.content_hash
+                ),
+            ));
+        }
+        warn(format_args!("{changed}; resuming anyway (--force)"));
         ckpt.content_hash = scene.content_hash;
     }
-    if scene.content_hash != ckpt.content_hash {
-        return Err(Error::checkpoint(
-            path,
-            format!(
-                "{} (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
-                changed_inputs(path, &ckpt.scene_path, &scene.inputs),
-                scene.content_hash,
-                ckpt.content_hash
-            ),
-        ));
-    }
+    // From here on the checkpoint records the scene's inputs as they are (an older
+    // version's checkpoint gains its per-input hashes).
+    ckpt.inputs = Some(scene.input_hashes.clone());
     if scene.settings != ckpt.settings {
         let diffs = scene.settings.differences(&ckpt.settings).join(", ");
         return Err(Error::checkpoint(path, format!("its settings load differently: {diffs}")));
@@ -169,7 +178,8 @@ fn same_file(a: &Path, b: &Path) -> bool {
     a == b || matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
 }
 
-/// Says which inputs of a resumed scene changed, as far as can be told. The
+/// Says which inputs of a resumed scene changed, as far as can be told, for a
+/// checkpoint of version 1 to 4 (a newer one has each input's hash). Such a
 /// checkpoint stores one hash over the scene file and every file it reads
 /// (meshes, data), not one per file, so: a scene that reads no other file
 /// changed itself; otherwise the inputs modified after the checkpoint file
