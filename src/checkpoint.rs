@@ -420,9 +420,9 @@ impl Checkpoint {
         if self.content_hash != other.content_hash {
             return Some(format!(
                 "different scene: {} (content hash {:016x}) vs {} (content hash {:016x})",
-                other.scene_path.display(),
+                show_path(&other.scene_path),
                 other.content_hash,
-                self.scene_path.display(),
+                show_path(&self.scene_path),
                 self.content_hash
             ));
         }
@@ -449,7 +449,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
     let mut prev_path = first_path.clone();
     for (path, c) in &parts[1..] {
         if let Some(why) = merged.incompatibility(c) {
-            return Err(Error::checkpoint(path, format!("cannot be merged with {}: {why}", first_path.display())));
+            return Err(Error::checkpoint(path, format!("cannot be merged with {}: {why}", show_path(first_path))));
         }
         let (have, next) = (merged.passes(), c.passes());
         if next.start < have.end {
@@ -461,7 +461,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
                     next.end,
                     have.start,
                     have.end,
-                    prev_path.display()
+                    show_path(&prev_path)
                 ),
             ));
         }
@@ -472,7 +472,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
                     "passes {}..{} are missing between {} (ends at {}) and this file (starts at {})",
                     have.end,
                     next.start,
-                    prev_path.display(),
+                    show_path(&prev_path),
                     have.end,
                     next.start
                 ),

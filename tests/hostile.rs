@@ -742,6 +742,35 @@ fn a_path_with_a_newline_keeps_messages_on_one_line() {
     std::fs::remove_file(&scene).unwrap();
     let e = one_error(&run(&["resume", s(&ck), "-q", "--spp", "4"]), 1);
     assert!(e.contains("a\\nb") && e.contains("cannot load its scene"), "{e}");
+    // Output paths checked up front (src/io/files.rs): a missing directory, an output
+    // that is an input, two outputs that are one file.
+    let scene = scene_in(&d, SCENE);
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("no\ndir/o.png"))]), 1);
+    assert!(e.contains("no\\ndir"), "{e}");
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png")), "--checkpoint", s(&scene)]), 1);
+    assert!(e.contains("a\\nb") && e.contains("refusing to overwrite an input"), "{e}");
+    let e = one_error(
+        &run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png")), "--checkpoint", s(&d.join("o.png"))]),
+        1,
+    );
+    assert!(e.contains("a\\nb") && e.contains("same file"), "{e}");
+    // Checkpoint paths in merge's messages (src/checkpoint.rs): overlapping parts, and
+    // parts of different scenes.
+    let part = |name: &str, passes: &str, scene: &Path| {
+        let ck = d.join(format!("{name}.ckpt"));
+        let png = d.join(format!("{name}.png"));
+        let o = run(&["render", s(scene), "-q", "-o", s(&png), "--checkpoint", s(&ck), "--passes", passes]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        ck
+    };
+    let (p, q) = (part("p", "0..2", &scene), part("q", "1..2", &scene));
+    let e = one_error(&run(&["merge", s(&p), s(&q), "-o", s(&d.join("m.png"))]), 1);
+    assert!(e.contains("overlap") && e.matches("a\\nb").count() == 2, "{e}");
+    let other = d.join("other.ron");
+    std::fs::write(&other, SCENE.replace("Constant(10)", "Constant(20)")).unwrap();
+    let r = part("r", "2..3", &other);
+    let e = one_error(&run(&["merge", s(&p), s(&r), "-o", s(&d.join("m.png"))]), 1);
+    assert!(e.contains("different scene") && e.matches("a\\nb").count() >= 3, "{e}");
 }
 
 /// Counts of one take the singular: "1 object, 1 light", "1 pass",
