@@ -355,6 +355,22 @@ fn every_bad_flag_value_is_one_usage_error() {
     assert!(one_error(&run(&["frobnicate"]), 2).contains("frobnicate"));
 }
 
+/// A flag's value that is not a number says the range the flag takes: `--spp abc` said
+/// "from 0 to 4294967295" although 0 is refused (issue 34 item 15).
+#[test]
+fn a_non_number_names_the_flags_own_range() {
+    for (flag, range) in [
+        ("--spp", "expected a whole number from 1 to 4294967295"),
+        ("--width", "expected a whole number from 1 to 32768"),
+        ("--seed", "expected a whole number from 0 to 18446744073709551615"),
+        ("--max-bounces", "expected a whole number from 0 to 4294967295"),
+        ("--packet-size", "expected 1, 2, 4 or 8"),
+    ] {
+        let e = one_error(&run(&["render", "scenes/cornell.ron", flag, "abc"]), 2);
+        assert!(e.contains(range) && e.contains("abc"), "{flag}: {e}");
+    }
+}
+
 // ---------------------------------------------------------------------------
 // 6. Scene text.
 
