@@ -268,6 +268,34 @@ fn sigint_ends_a_render_promptly_and_saves_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(t.elapsed() < Duration::from_secs(5), "took {:?} to stop", t.elapsed());
     assert!(wait_for(Duration::from_secs(1), || ckpt.exists()), "no checkpoint after SIGINT");
+    // The message names both files it wrote (issue 34 item 15: it named only the snapshot).
+    let err = stderr(&o);
+    let line = err.lines().find(|l| l.contains("stopped by a signal")).unwrap_or_else(|| panic!("{err}"));
+    assert!(line.contains("wrote snapshot") && line.contains(&format!("and checkpoint {}", s(&ckpt))), "{err}");
+}
+
+/// `resume --spp N` below the passes a checkpoint holds renders nothing and says why,
+/// then writes the image of the passes held and exits 0 (issue 34 item 15: it said
+/// "0 passes" and nothing more); `render --passes A..B` says which passes of how many
+/// spp it renders (it said "64 spp" for `--passes 0..32`).
+#[test]
+fn resume_below_its_passes_and_pass_ranges_say_what_they_do() {
+    let d = temp_dir("hostile-fewer");
+    let scene = scene_in(&d, &SCENE.replace("spp: 2", "spp: 4"));
+    let ck = d.join("a.ckpt");
+    let o = run(&["render", s(&scene), "-o", s(&d.join("a.png")), "--checkpoint", s(&ck), "--passes", "0..3"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("8x8, passes 0..3 of 4 spp,"), "{err}");
+    let o = run(&["render", s(&scene), "-o", s(&d.join("b.png"))]);
+    assert!(stderr(&o).contains("8x8, 4 spp,"), "{}", stderr(&o));
+    let out = d.join("fewer.png");
+    let o = run(&["resume", s(&ck), "--spp", "2", "-o", s(&out)]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("the checkpoint already holds 3 passes; --spp 2 asks for fewer: nothing to render"), "{err}");
+    assert!(out.exists(), "the image of the passes held");
+    assert_eq!(rust_v::checkpoint::Checkpoint::read(&ck).unwrap().passes(), 0..3, "nothing lost");
 }
 
 /// SIGINT or SIGTERM while the scene is still loading ends the process at once with

@@ -54,23 +54,27 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
             "--spectral keeps the 36 bin centres, so it cannot follow --wavelengths continuous (use hero)".into(),
         ));
     }
+    // With a time budget and no --spp (or --passes), render until the time is up.
+    let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     if !args.run.quiet {
+        let spp = match (&args.passes, args.time) {
+            (Some(p), _) => format!("passes {}..{} of {} spp", p.start, p.end, s.spp),
+            (None, Some(t)) if open_ended => format!("as many passes as {t} s allow"),
+            _ => format!("{} spp", s.spp),
+        };
         say(format_args!(
-            "{} ({}, {}, loaded in {:.2} s): {}x{}, {} spp, {}, seed {}",
+            "{} ({}, {}, loaded in {:.2} s): {}x{}, {spp}, {}, seed {}",
             show_path(&args.scene),
             count(scene.object_count() as u64, "object"),
             count(scene.lights.len() as u64, "light"),
             load_time.as_secs_f64(),
             s.width,
             s.height,
-            s.spp,
             count(s.max_bounces, "bounce"),
             s.seed,
         ));
         say(format_args!("{}", rust_v::integrator::describe(&scene)));
     }
-    // With a time budget and no --spp (or --passes), render until the time is up.
-    let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output));
     check_files(&args.scene, &scene, &[], &output, &checkpoint_path, args.spectral)?;
@@ -112,7 +116,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
         None => ckpt.target_end,
     };
     if args.spp.is_some() {
-        ckpt.settings.spp = end - done.start;
+        ckpt.settings.spp = end.max(done.end) - done.start;
     }
     let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
     check_output_extension(&output)?;
@@ -146,6 +150,14 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     if scene.settings != ckpt.settings {
         let diffs = scene.settings.differences(&ckpt.settings).join(", ");
         return Err(Error::checkpoint(path, format!("its settings load differently: {diffs}")));
+    }
+    if let Some(spp) = args.spp.filter(|_| end <= done.end && !args.run.quiet) {
+        // Nothing to render: say why, then write the image of the passes held.
+        say(format_args!(
+            "the checkpoint already holds {}; --spp {spp} asks for {}: nothing to render",
+            count(done.end - done.start, "pass"),
+            if end < done.end { "fewer" } else { "no more" }
+        ));
     }
     if !args.run.quiet {
         say(format_args!(
