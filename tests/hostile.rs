@@ -878,3 +878,58 @@ fn counts_of_one_are_singular() {
     let err = stderr(&o);
     assert!(err.contains("1 bounce,") && err.contains("(2 passes in"), "{err}");
 }
+
+// ---------------------------------------------------------------------------
+// 16. Coincident surfaces (issue 34 item 17).
+
+/// Two dielectric objects with the same surface (glass and water spheres of one
+/// centre and radius): a ray meets only one of the two surfaces at each crossing, so the
+/// medium stack cannot follow. The README said the one listed first wins (a camera
+/// inside would see Y = n² = 2.25 for glass in a furnace of radiance 1, as for the
+/// glass sphere alone); measured, both orders and a higher water priority give exactly
+/// Y = 1, as if neither volume were there. The documented behaviour is now that: such a
+/// pair is not supported, and loading it warns naming both objects (before: no
+/// warning). A pair that overlaps without sharing the surface does not warn.
+#[test]
+fn coincident_dielectrics_warn_and_behave_as_documented() {
+    let enclosure = "(shape: Sphere(center: (0, 0, 0), radius: 10), emission: Constant(1), two_sided: true)";
+    let scene = |objects: &str| {
+        format!(
+            r#"(
+    camera: (eye: (0, 0, 0.2), look_at: (0, 0, -1), fov_deg: 30),
+    render: (width: 8, height: 8, spp: 2),
+    materials: {{ "glass": Dielectric(ior: Constant(1.5)), "water": Dielectric(ior: Constant(1.33)) }},
+    objects: [ {objects} {enclosure} ],
+)"#
+        )
+    };
+    let glass = r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"),"#;
+    let water = r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "water"),"#;
+    let water_first = r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "water", priority: 1),"#;
+    let mean_y = |text: &str| {
+        let film = furnace_film(text, "path", 4);
+        film.mean_xyz().iter().map(|p| p[1]).sum::<f64>() / (film.width() * film.height()) as f64
+    };
+    let alone = mean_y(&scene(glass));
+    assert!((alone - 2.25).abs() < 1e-3, "the glass sphere alone: {alone}");
+    for objects in [format!("{glass} {water}"), format!("{water} {glass}"), format!("{glass} {water_first}")] {
+        let y = mean_y(&scene(&objects));
+        assert!((y - 1.0).abs() < 1e-3, "{objects}: {y}");
+    }
+    let d = temp_dir("hostile-coincident");
+    let path = scene_in(&d, &scene(&format!("{glass} {water}")));
+    let o = run(&["render", s(&path), "-q", "-o", s(&d.join("o.png"))]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].starts_with("rust-v: warning: objects[0] and objects[1]") && lines[0].contains("same surface"),
+        "{err}"
+    );
+    // Overlapping volumes with priorities, the documented way, do not warn.
+    let inner = r#"(shape: Sphere(center: (0, 0, 0), radius: 0.9), material: "water", priority: 1),"#;
+    let path = scene_in(&d, &scene(&format!("{glass} {inner}")));
+    let o = run(&["render", s(&path), "-q", "-o", s(&d.join("o.png"))]);
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
+}

@@ -334,8 +334,9 @@ fn check_files(
 }
 
 /// Warns about what the scene asks for that cannot happen: a `priority` on an
-/// object that is not a dielectric (only dielectric volumes nest), and a
-/// scene without any light (the image is black).
+/// object that is not a dielectric (only dielectric volumes nest), two
+/// dielectrics with the same surface, and a scene without any light (the
+/// image is black).
 fn warn_no_effect(scene: &Scene) {
     for (i, o) in scene.objects.iter().enumerate() {
         let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
@@ -343,6 +344,21 @@ fn warn_no_effect(scene: &Scene) {
             warn(format_args!(
                 "objects[{i}].priority: {} has no effect: the object is not a dielectric, and only dielectric volumes nest by priority",
                 o.priority
+            ));
+        }
+    }
+    // Two dielectric objects with the same surface: a ray meets one of the two surfaces
+    // at each crossing, so the medium stack cannot follow (measured: coincident glass and
+    // water spheres act as neither). Shapes compared exactly; meshes are not compared.
+    let mut seen = std::collections::HashMap::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
+        if !dielectric || matches!(o.shape, rust_v::shape::Shape::Mesh(_)) {
+            continue;
+        }
+        if let Some(first) = seen.insert(format!("{:?}", o.shape), i) {
+            warn(format_args!(
+                "objects[{first}] and objects[{i}] are dielectrics with the same surface: a ray meets only one of two coincident surfaces, so neither volume is rendered right; make one volume overlap the other and give it a higher priority (docs/scene-format.md, Nested dielectrics)"
             ));
         }
     }
