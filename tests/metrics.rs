@@ -207,6 +207,28 @@ fn compare_warns_when_a_png_meets_an_exr() {
         let o = rust_v(&["compare", &s(a), &s(b)]);
         assert!(o.status.success() && o.stderr.is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
     }
+    // converge measures linear renders: a PNG reference gets the same warning, an EXR none.
+    let scene = root().join("scenes/cornell.ron");
+    for (reference, warned) in [(&png, true), (&exr, false)] {
+        let out = dir.join("out");
+        let o = rust_v(&[
+            "converge",
+            &s(&scene),
+            "--reference",
+            &s(reference),
+            "--methods",
+            "path",
+            "--spp-schedule",
+            "1",
+            "--out",
+            &s(&out),
+            "--quiet",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert_eq!(err.lines().count(), usize::from(warned), "{err}");
+        assert!(!warned || (err.contains("a.png") && err.contains("relMSE")), "{err}");
+    }
 }
 
 #[test]

@@ -74,7 +74,7 @@ fn warn_mixed_sources(a: &Path, sa: Source, b: &Path, sb: Source) {
     }
     let (png, exr) = if sa == Source::Encoded { (a, b) } else { (b, a) };
     warn(format_args!(
-        "{} is a PNG (clamped to [0, 1], sRGB-encoded, 16-bit) and {} a linear EXR: the linear metrics (linear MSE and PSNR, relMSE, mean relative errors, firefly share) compare clamped against unclamped values; the 16-bit sRGB metrics (MSE, PSNR, SSIM, variance, windowed SSIM) compare like with like; compare two EXRs for linear errors",
+        "{} is a PNG (clamped to [0, 1], sRGB-encoded, 16-bit) and {} linear: the linear metrics (linear MSE and PSNR, relMSE, mean relative errors, firefly share) compare clamped against unclamped values; the 16-bit sRGB metrics (MSE, PSNR, SSIM, variance, windowed SSIM) compare like with like; use EXR files for linear errors",
         show_path(png),
         show_path(exr)
     ));
@@ -179,6 +179,8 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
             reference.height
         )));
     }
+    // The renders are measured as linear images (like an EXR).
+    warn_mixed_sources(Path::new("the renders"), Source::Linear, &args.reference, reference.source);
     let schedule = match (&args.time, &args.spp_schedule) {
         (Some(t), _) => Schedule::Time(Duration::from_secs_f64(*t)),
         (None, Some(v)) => Schedule::Spp(v.clone()),
