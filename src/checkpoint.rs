@@ -8,7 +8,7 @@
 //! checkpoint only has to hold whole passes, their range, the settings, and
 //! which scene they belong to.
 //!
-//! # File format (version 3)
+//! # File format (version 5)
 //! All integers little-endian.
 //!
 //! | bytes | content |
@@ -18,10 +18,10 @@
 //! | 4 | header length `H` (`u32`) |
 //! | 8 | payload length `P` (`u64`) |
 //! | 8 | checksum: FNV-1a 64 of the header and payload bytes |
-//! | H | header: bincode (standard config) of the writer's crate version, the scene file's absolute path and content hash, all [`Settings`], the pass range held, the target pass, the output path |
+//! | H | header: bincode (standard config) of the writer's crate version, the scene file's absolute path and content hash, all [`Settings`], the pass range held, the target pass, the output path, then [`InputHashes`]: the scene file's hash and each file it reads (name in the scene, hash) |
 //! | P | payload: lz4_flex block (size prepended) of bincode of the film: width, height and 3 fixed-point `i128` sums per pixel |
 //!
-//! A spectral film (`--spectral`) is written as version 4 ([`SPECTRAL_FORMAT_VERSION`]): the
+//! A spectral film (`--spectral`) is written as version 6 ([`SPECTRAL_FORMAT_VERSION`]): the
 //! same layout, its payload followed (inside the same lz4 block) by `width × height × 36`
 //! fixed-point per-bin sums.
 //!
@@ -29,8 +29,11 @@
 //! are still read: their header's settings end before `sampler`, and they resume and
 //! merge as `sampler: independent`, the sampler that wrote them (the independent
 //! sampler's numbers are unchanged, so such a resume is bit-exact). Versions 3 and 4
-//! are versions 1 and 2 with the sampler's name after the other settings; a rust-v that
-//! predates them refuses them with its "format version" error.
+//! are versions 1 and 2 with the sampler's name after the other settings. Versions 5 and
+//! 6 are versions 3 and 4 with each input's hash after the header ([`InputHashes`]), so
+//! that `resume` names exactly the inputs that changed; versions 1 to 4 still load, with
+//! [`Checkpoint::inputs`] `None` (and such a checkpoint is written as version 3 or 4). A
+//! rust-v that predates a version refuses it with its "format version" error.
 //!
 //! Reading checks the magic, the version, the exact length (a truncated
 //! file is reported as such), the checksum, then decodes and validates every
@@ -44,7 +47,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::color::N_BINS;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, show_path};
 use crate::film::Film;
 use crate::io::Fnv1a;
 use crate::io::write_atomic;
@@ -54,15 +57,61 @@ use crate::settings::{Settings, SettingsFormat1};
 pub const MAGIC: [u8; 8] = *b"RUSTVCKP";
 
 /// The format version this build writes for colour-only films, and reads.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 5;
 
-/// The format version of a spectral film's checkpoint (`--spectral`): version 3 whose payload
+/// The format version of a spectral film's checkpoint (`--spectral`): version 5 whose payload
 /// also holds 36 fixed-point per-bin sums per pixel after the XYZ sums. Colour-only renders
-/// write version 3, so their checkpoints stay as small as before.
-pub const SPECTRAL_FORMAT_VERSION: u32 = 4;
+/// write version 5, so their checkpoints stay as small as before.
+pub const SPECTRAL_FORMAT_VERSION: u32 = 6;
 
 /// The versions written before the `sampler` setting (colour, spectral): read, never written.
 pub const FORMAT_1_VERSIONS: [u32; 2] = [1, 2];
+
+/// The versions with the sampler but one hash over all inputs (colour, spectral): read, and
+/// written only for a checkpoint without per-input hashes ([`Checkpoint::inputs`] `None`).
+pub const FORMAT_3_VERSIONS: [u32; 2] = [3, 4];
+
+/// The identity of each input of a scene, for saying which one changed: the scene
+/// file's FNV-1a hash, and each file it reads by its name as written in the scene
+/// and the FNV-1a hash of its bytes, in the order read.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct InputHashes {
+    /// FNV-1a of the scene file's bytes.
+    pub scene: u64,
+    /// Each file the scene reads (meshes, data): its name in the scene, FNV-1a of its bytes.
+    pub files: Vec<(String, u64)>,
+}
+
+/// What changed between the inputs a checkpoint recorded (`old`) and the scene's now
+/// (`new`): one phrase per changed input, the scene file first (named by `scene`), then
+/// each file by its path (its name in the scene, relative to the scene's folder). Empty
+/// when nothing differs.
+pub fn changed_inputs(old: &InputHashes, new: &InputHashes, scene: &Path) -> Vec<String> {
+    let dir = scene.parent().unwrap_or(Path::new(""));
+    let file = |name: &str| show_path(&dir.join(name)).to_string();
+    let mut changed = Vec::new();
+    if old.scene != new.scene {
+        changed.push(format!("the scene file {}", show_path(scene)));
+    }
+    let find = |list: &[(String, u64)], name: &str| list.iter().find(|(n, _)| n == name).map(|&(_, h)| h);
+    let mut seen = std::collections::BTreeSet::new();
+    for (name, hash) in &new.files {
+        if !seen.insert(name.as_str()) {
+            continue;
+        }
+        match find(&old.files, name) {
+            Some(h) if h == *hash => {}
+            Some(_) => changed.push(file(name)),
+            None => changed.push(format!("{} (not read before)", file(name))),
+        }
+    }
+    for (name, _) in &old.files {
+        if find(&new.files, name).is_none() && seen.insert(name.as_str()) {
+            changed.push(format!("{} (no longer read)", file(name)));
+        }
+    }
+    changed
+}
 
 /// Bytes before the header: magic, version, two lengths, checksum.
 const PREFIX_LEN: usize = 32;
@@ -87,6 +136,10 @@ pub struct Checkpoint {
     pub output: PathBuf,
     /// The passes done so far.
     pub film: Film,
+    /// Each input's hash (versions 5 and 6), to name the inputs that changed; `None`
+    /// when read from an older version, which holds only [`Checkpoint::content_hash`]
+    /// (such a checkpoint is written as version 3 or 4 again).
+    pub inputs: Option<InputHashes>,
 }
 
 /// The header as encoded. [`Settings`] encodes field by field with its enums
@@ -102,6 +155,13 @@ struct Header<S = Settings> {
     end_pass: u32,
     target_end: u32,
     output: PathBuf,
+}
+
+/// The header of versions 5 and 6: version 3's, then each input's hash.
+#[derive(Serialize, Deserialize)]
+struct HeaderWithInputs {
+    header: Header,
+    inputs: InputHashes,
 }
 
 #[derive(Serialize)]
@@ -184,12 +244,18 @@ impl Checkpoint {
         let config = bincode::config::standard();
         let encode_error =
             |e: bincode::error::EncodeError| Error::checkpoint(&self.output, format!("cannot encode: {e}"));
-        let header = bincode::serde::encode_to_vec(&header, config).map_err(encode_error)?;
+        let header = match &self.inputs {
+            Some(inputs) => bincode::serde::encode_to_vec(HeaderWithInputs { header, inputs: inputs.clone() }, config),
+            None => bincode::serde::encode_to_vec(&header, config),
+        }
+        .map_err(encode_error)?;
         let (width, height, sums) = (film.width(), film.height(), film.sums());
+        let [colour_version, spectral_version] =
+            if self.inputs.is_some() { [FORMAT_VERSION, SPECTRAL_FORMAT_VERSION] } else { FORMAT_3_VERSIONS };
         let (version, raw) = match film.spectral_sums() {
-            None => (FORMAT_VERSION, bincode::serde::encode_to_vec(PayloadRef { width, height, sums }, config)),
+            None => (colour_version, bincode::serde::encode_to_vec(PayloadRef { width, height, sums }, config)),
             Some(spectral) => (
-                SPECTRAL_FORMAT_VERSION,
+                spectral_version,
                 bincode::serde::encode_to_vec(
                     SpectralPayloadRef { width, height, sums, spectral: spectral.as_flattened() },
                     config,
@@ -227,8 +293,9 @@ impl Checkpoint {
                 env!("CARGO_PKG_VERSION")
             )));
         }
-        let spectral = version == FORMAT_1_VERSIONS[1] || version == SPECTRAL_FORMAT_VERSION;
+        let spectral = [2, 4, SPECTRAL_FORMAT_VERSION].contains(&version);
         let format_1 = FORMAT_1_VERSIONS.contains(&version);
+        let format_3 = FORMAT_3_VERSIONS.contains(&version);
         let header_len = u32_at(bytes, 12);
         let payload_len = u64_at(bytes, 16);
         if header_len > MAX_HEADER_LEN {
@@ -254,6 +321,7 @@ impl Checkpoint {
         let config = bincode::config::standard();
         let header_config = config.with_limit::<{ 1 << 20 }>();
         let corrupt_header = |e: bincode::error::DecodeError| bad(format!("corrupt header: {e}"));
+        let mut inputs = None;
         let (h, used): (Header, usize) = if format_1 {
             let (h, used): (Header<SettingsFormat1>, usize) =
                 bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?;
@@ -264,8 +332,13 @@ impl Checkpoint {
                 Header { crate_version, scene_path, content_hash, settings, first_pass, end_pass, target_end, output },
                 used,
             )
-        } else {
+        } else if format_3 {
             bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?
+        } else {
+            let (h, used): (HeaderWithInputs, usize) =
+                bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?;
+            inputs = Some(h.inputs);
+            (h.header, used)
         };
         if used != header_bytes.len() {
             return Err(bad("corrupt header: trailing bytes".into()));
@@ -317,6 +390,7 @@ impl Checkpoint {
             target_end: h.target_end,
             output: h.output,
             film,
+            inputs,
         })
     }
 
@@ -346,9 +420,9 @@ impl Checkpoint {
         if self.content_hash != other.content_hash {
             return Some(format!(
                 "different scene: {} (content hash {:016x}) vs {} (content hash {:016x})",
-                other.scene_path.display(),
+                show_path(&other.scene_path),
                 other.content_hash,
-                self.scene_path.display(),
+                show_path(&self.scene_path),
                 self.content_hash
             ));
         }
@@ -375,7 +449,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
     let mut prev_path = first_path.clone();
     for (path, c) in &parts[1..] {
         if let Some(why) = merged.incompatibility(c) {
-            return Err(Error::checkpoint(path, format!("cannot be merged with {}: {why}", first_path.display())));
+            return Err(Error::checkpoint(path, format!("cannot be merged with {}: {why}", show_path(first_path))));
         }
         let (have, next) = (merged.passes(), c.passes());
         if next.start < have.end {
@@ -387,7 +461,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
                     next.end,
                     have.start,
                     have.end,
-                    prev_path.display()
+                    show_path(&prev_path)
                 ),
             ));
         }
@@ -398,7 +472,7 @@ pub fn merge(mut parts: Vec<(PathBuf, Checkpoint)>) -> Result<Checkpoint> {
                     "passes {}..{} are missing between {} (ends at {}) and this file (starts at {})",
                     have.end,
                     next.start,
-                    prev_path.display(),
+                    show_path(&prev_path),
                     have.end,
                     next.start
                 ),
@@ -446,6 +520,7 @@ mod tests {
             target_end: 20,
             output: "/out/x.png".into(),
             film,
+            inputs: Some(InputHashes { scene: 7, files: vec![("mesh.obj".into(), 8), ("refl.csv".into(), 9)] }),
         }
     }
 
@@ -490,9 +565,39 @@ mod tests {
         assert_eq!(Checkpoint::decode(&bytes, Path::new("o.ckpt")).unwrap().settings, other.settings);
         assert!(c.incompatibility(&other).is_some_and(|why| why.contains("sampler")));
         let mut bytes = c.encode().unwrap();
-        bytes[8..12].copy_from_slice(&5u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&7u32.to_le_bytes());
         let e = Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap_err().to_string();
-        assert!(e.contains("format version 5") && e.contains("reads versions 1 to 4"), "{e}");
+        assert!(e.contains("format version 7") && e.contains("reads versions 1 to 6"), "{e}");
+    }
+
+    /// Versions 5 and 6 keep each input's hash; a checkpoint without them (read from an
+    /// older version) is written as version 3 and reads back without them.
+    #[test]
+    fn per_input_hashes_and_version_3() {
+        let c = sample();
+        let bytes = c.encode().unwrap();
+        assert_eq!(u32_at(&bytes, 8), FORMAT_VERSION);
+        assert_eq!(Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap().inputs, c.inputs);
+        let old = Checkpoint { inputs: None, ..c.clone() };
+        let bytes = old.encode().unwrap();
+        assert_eq!(u32_at(&bytes, 8), 3);
+        assert_eq!(Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap(), old);
+    }
+
+    /// Exactly the inputs whose hash differs are named, the scene file by its path.
+    #[test]
+    fn changed_inputs_names_exactly_the_changed_ones() {
+        let files = |v: &[(&str, u64)]| v.iter().map(|&(n, h)| (n.to_string(), h)).collect();
+        let old = InputHashes { scene: 1, files: files(&[("a.obj", 2), ("b.csv", 3), ("c.ply", 4)]) };
+        let scene = Path::new("d/s.ron");
+        assert!(changed_inputs(&old, &old, scene).is_empty());
+        let new = InputHashes { scene: 1, files: files(&[("a.obj", 2), ("b.csv", 30), ("d.ply", 5)]) };
+        assert_eq!(
+            changed_inputs(&old, &new, scene),
+            ["d/b.csv", "d/d.ply (not read before)", "d/c.ply (no longer read)"]
+        );
+        let new = InputHashes { scene: 10, ..old.clone() };
+        assert_eq!(changed_inputs(&old, &new, scene), ["the scene file d/s.ron"]);
     }
 
     #[test]

@@ -35,6 +35,7 @@ fn meta(scene: &Scene, film: Film) -> Checkpoint {
         target_end: 100,
         output: "/tmp/x.png".into(),
         film,
+        inputs: Some(scene.input_hashes.clone()),
     }
 }
 
@@ -405,8 +406,8 @@ fn help_documents_the_checkpoint_flags_and_subcommands() {
 
 /// The same promise for a spectral film (`--spectral`) on a dispersive scene (the prism: `auto`
 /// splits into single wavelengths there): 0..40 == merge(0..20, 20..40) == 0..20 saved (format
-/// version 4), loaded and continued, bit for bit in the XYZ and the 36 per-bin sums; and a
-/// colour-only checkpoint writes version 3.
+/// version 6), loaded and continued, bit for bit in the XYZ and the 36 per-bin sums; and a
+/// colour-only checkpoint writes version 5.
 #[test]
 fn spectral_films_merge_and_resume_bit_identically() {
     let mut o = SettingsPatch::default();
@@ -430,7 +431,7 @@ fn spectral_films_merge_and_resume_bit_identically() {
     render_into(&scene, &mut resumed, 20..40);
     assert_eq!(resumed, whole);
 
-    // A spectral and a colour-only film do not merge; colour-only checkpoints are version 3.
+    // A spectral and a colour-only film do not merge; colour-only checkpoints are version 5.
     let mut plain = Film::starting_at(12, 12, 20);
     render_into(&scene, &mut plain, 20..40);
     assert!(a.clone().merge(&plain).is_err());

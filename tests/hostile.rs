@@ -268,6 +268,75 @@ fn sigint_ends_a_render_promptly_and_saves_it() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(t.elapsed() < Duration::from_secs(5), "took {:?} to stop", t.elapsed());
     assert!(wait_for(Duration::from_secs(1), || ckpt.exists()), "no checkpoint after SIGINT");
+    // The message names both files it wrote (issue 34 item 15: it named only the snapshot).
+    let err = stderr(&o);
+    let line = err.lines().find(|l| l.contains("stopped by a signal")).unwrap_or_else(|| panic!("{err}"));
+    assert!(line.contains("wrote snapshot") && line.contains(&format!("and checkpoint {}", s(&ckpt))), "{err}");
+}
+
+/// `resume --spp N` below the passes a checkpoint holds renders nothing and says why,
+/// then writes the image of the passes held and exits 0 (issue 34 item 15: it said
+/// "0 passes" and nothing more); `render --passes A..B` says which passes of how many
+/// spp it renders (it said "64 spp" for `--passes 0..32`).
+#[test]
+fn resume_below_its_passes_and_pass_ranges_say_what_they_do() {
+    let d = temp_dir("hostile-fewer");
+    let scene = scene_in(&d, &SCENE.replace("spp: 2", "spp: 4"));
+    let ck = d.join("a.ckpt");
+    let o = run(&["render", s(&scene), "-o", s(&d.join("a.png")), "--checkpoint", s(&ck), "--passes", "0..3"]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("8x8, passes 0..3 of 4 spp,"), "{err}");
+    let o = run(&["render", s(&scene), "-o", s(&d.join("b.png"))]);
+    assert!(stderr(&o).contains("8x8, 4 spp,"), "{}", stderr(&o));
+    let out = d.join("fewer.png");
+    let o = run(&["resume", s(&ck), "--spp", "2", "-o", s(&out)]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("the checkpoint already holds 3 passes; --spp 2 asks for fewer: nothing to render"), "{err}");
+    assert!(out.exists(), "the image of the passes held");
+    assert_eq!(rust_v::checkpoint::Checkpoint::read(&ck).unwrap().passes(), 0..3, "nothing lost");
+}
+
+/// SIGINT or SIGTERM while the scene is still loading ends the process at once with
+/// 130 or 143 and writes nothing: no image, snapshot or checkpoint (issue 34 item 9;
+/// docs/checkpoint.md promised a 0-pass checkpoint). The scene loads slowly: its mesh is
+/// 64 concatenated gzip members of 1 Mi comment lines each (575 KB, 128 MB of OBJ text,
+/// about 2 s to load); the signal goes once /proc shows the handlers installed.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_signal_while_loading_exits_130_or_143_and_writes_nothing() {
+    use std::io::Write;
+    let d = temp_dir("hostile-sigload");
+    let mut member = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    member.write_all(&b"#\n".repeat(1 << 20)).unwrap();
+    let member = member.finish().unwrap();
+    std::fs::write(d.join("slow.obj.gz"), member.repeat(64)).unwrap();
+    let scene = scene_in(&d, &MESH_SCENE.replace("tri.obj", "slow.obj.gz"));
+    for (signal, mask, status) in [("-INT", 1u64 << 1, 130), ("-TERM", 1 << 14, 143)] {
+        let child = bin()
+            .args(["render", s(&scene), "-o", s(&d.join("o.png")), "--checkpoint", s(&d.join("o.ckpt"))])
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let pid = child.id().to_string();
+        let caught = || {
+            let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+            let mask_now = status.lines().find_map(|l| l.strip_prefix("SigCgt:")).map(str::trim);
+            mask_now.and_then(|m| u64::from_str_radix(m, 16).ok()).is_some_and(|m| m & mask != 0)
+        };
+        assert!(wait_for(Duration::from_secs(10), caught), "the handlers were never installed");
+        let t = Instant::now();
+        Command::new("kill").args([signal, &pid]).status().unwrap();
+        let o = child.wait_with_output().unwrap();
+        assert_eq!(o.status.code(), Some(status), "{signal}: {}", stderr(&o));
+        assert!(t.elapsed() < Duration::from_millis(1500), "{signal}: took {:?} (loading finished?)", t.elapsed());
+        assert!(stderr(&o).is_empty(), "{signal}: {}", stderr(&o));
+        let mut files: Vec<String> =
+            std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        files.sort();
+        assert_eq!(files, ["scene.ron", "slow.obj.gz"], "{signal}: nothing written");
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -312,6 +381,22 @@ fn every_bad_flag_value_is_one_usage_error() {
     assert!(one_error(&run(&["resume", "x.ckpt", "--spp", "0"]), 2).contains("--spp"));
     assert!(one_error(&run(&["converge", scene, "--reference", "r.exr", "--seeds", "0"]), 2).contains("--seeds"));
     assert!(one_error(&run(&["frobnicate"]), 2).contains("frobnicate"));
+}
+
+/// A flag's value that is not a number says the range the flag takes: `--spp abc` said
+/// "from 0 to 4294967295" although 0 is refused (issue 34 item 15).
+#[test]
+fn a_non_number_names_the_flags_own_range() {
+    for (flag, range) in [
+        ("--spp", "expected a whole number from 1 to 4294967295"),
+        ("--width", "expected a whole number from 1 to 32768"),
+        ("--seed", "expected a whole number from 0 to 18446744073709551615"),
+        ("--max-bounces", "expected a whole number from 0 to 4294967295"),
+        ("--packet-size", "expected 1, 2, 4 or 8"),
+    ] {
+        let e = one_error(&run(&["render", "scenes/cornell.ron", flag, "abc"]), 2);
+        assert!(e.contains(range) && e.contains("abc"), "{flag}: {e}");
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -452,38 +537,79 @@ fn resume_and_merge_refuse_changed_meshes() {
     std::thread::sleep(Duration::from_millis(50));
     std::fs::write(&mesh, TRI_OBJ.replace("v 0 1 0", "v 0 0.9 0")).unwrap();
     let b = part("b", "1..2");
-    // The changed input is named (issue 34 item 16): the mesh, modified after the checkpoint.
+    // The changed input is named (issue 34 item 16): the mesh, by its own hash.
     let e = one_error(&run(&["resume", s(&a), "-q"]), 1);
-    assert!(e.contains("changed") && e.contains("mesh"), "{e}");
-    assert!(e.contains(&format!("{} modified after it", s(&mesh))), "{e}");
+    assert!(e.contains(&format!(": {} changed since the checkpoint was written", s(&mesh))), "{e}");
     // (To another checkpoint: a finished resume updates the one it writes.)
     let o = run(&["resume", s(&a), "-q", "--force", "--checkpoint", s(&d.join("forced.ckpt"))]);
     assert!(o.status.success() && stderr(&o).contains("warning"), "{}", stderr(&o));
-    assert!(stderr(&o).contains(&format!("{} modified after it", s(&mesh))), "{}", stderr(&o));
+    assert!(stderr(&o).contains(&format!("{} changed since", s(&mesh))), "{}", stderr(&o));
     let e = one_error(&run(&["merge", s(&a), s(&b), "-o", s(&d.join("m.png"))]), 1);
     assert!(e.contains("different scene"), "{e}");
     // A spectrum file is an input too.
     std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.8\n").unwrap();
     std::fs::write(&scene, SCENE.replace("Constant(0.5)", "File(\"refl.csv\")")).unwrap();
     let c = part("c", "0..1");
+    // The same as version 3 (before per-input hashes): one hash over all inputs.
+    let c3 = d.join("c3.ckpt");
+    let mut old_version = rust_v::checkpoint::Checkpoint::read(&c).unwrap();
+    old_version.inputs = None;
+    old_version.write(&c3).unwrap();
+    assert_eq!(std::fs::read(&c3).unwrap()[8], 3, "written as version 3");
     std::thread::sleep(Duration::from_millis(50));
     std::fs::write(d.join("refl.csv"), "400,0.2\n700,0.7\n").unwrap();
     let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
-    assert!(e.contains("changed") && e.contains("refl.csv modified after it"), "{e}");
-    // When no input is newer than the checkpoint, every input is named as possibly changed
-    // (the checkpoint keeps one hash over them all).
+    assert!(e.contains(&format!(": {} changed since", s(&d.join("refl.csv")))), "{e}");
+    // A checkpoint of version 3 keeps one hash over all inputs: the inputs modified after
+    // it are named, and when none is, every input is named as possibly changed.
+    let e = one_error(&run(&["resume", s(&c3), "-q", "--spp", "2"]), 1);
+    assert!(e.contains("refl.csv modified after it"), "{e}");
     let old = std::time::SystemTime::UNIX_EPOCH + Duration::from_secs(1_000_000_000);
     for f in [d.join("refl.csv"), scene.clone()] {
         std::fs::File::options().write(true).open(&f).unwrap().set_modified(old).unwrap();
     }
-    let e = one_error(&run(&["resume", s(&c), "-q", "--spp", "2"]), 1);
+    let e = one_error(&run(&["resume", s(&c3), "-q", "--spp", "2"]), 1);
     assert!(e.contains("refl.csv") && e.contains("which is not known"), "{e}");
+    // It still resumes (--force), and the resumed checkpoint gains each input's hash.
+    let o = run(&["resume", s(&c3), "-q", "--force", "--spp", "2", "-o", s(&d.join("c3.png"))]);
+    assert!(o.status.success() && stderr(&o).contains("which is not known"), "{}", stderr(&o));
+    let resumed = rust_v::checkpoint::Checkpoint::read(&c3).unwrap();
+    assert_eq!((std::fs::read(&c3).unwrap()[8], resumed.passes()), (5, 0..2));
     // A scene that reads no other file: the scene file itself changed.
     std::fs::write(&scene, SCENE).unwrap();
     let plain = part("plain", "0..1");
     std::fs::write(&scene, SCENE.replace("Constant(0.5)", "Constant(0.6)")).unwrap();
     let e = one_error(&run(&["resume", s(&plain), "-q"]), 1);
     assert!(e.contains(&format!("the scene file {} changed", s(&scene))), "{e}");
+}
+
+/// Of two inputs that were both written after the checkpoint (as a checkout or a copy
+/// does), only the one whose bytes changed is named, by `resume` and by `resume --force`
+/// (issue 34 item 16: with one hash over all inputs, both were named by modification time).
+#[test]
+fn resume_names_exactly_the_changed_input() {
+    let d = temp_dir("hostile-which-input");
+    let scene = scene_in(&d, &MESH_SCENE.replace("Constant(0.5)", "File(\"refl.csv\")"));
+    let (mesh, csv) = (d.join("tri.obj"), d.join("refl.csv"));
+    std::fs::write(&mesh, TRI_OBJ).unwrap();
+    std::fs::write(&csv, "400,0.2\n700,0.8\n").unwrap();
+    let ck = d.join("a.ckpt");
+    let o = run(&["render", s(&scene), "-q", "-o", s(&d.join("a.png")), "--checkpoint", s(&ck), "--passes", "0..1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::thread::sleep(Duration::from_millis(50));
+    std::fs::write(&mesh, TRI_OBJ.replace("v 0 1 0", "v 0 0.9 0")).unwrap();
+    std::fs::write(&csv, "400,0.2\n700,0.8\n").unwrap();
+    std::fs::write(&scene, std::fs::read(&scene).unwrap()).unwrap();
+    let e = one_error(&run(&["resume", s(&ck), "-q"]), 1);
+    assert!(e.contains(&format!(": {} changed since the checkpoint was written (", s(&mesh))), "{e}");
+    assert!(!e.contains("refl.csv") && !e.contains("scene.ron ") && !e.contains("scene file"), "{e}");
+    let o = run(&["resume", s(&ck), "-q", "--force", "-o", s(&d.join("b.png"))]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains(&format!("{} changed since", s(&mesh))) && !err.contains("refl.csv"), "{err}");
+    // The forced resume recorded the new inputs: resuming again is not refused.
+    let o = run(&["resume", s(&ck), "-q", "--spp", "2", "-o", s(&d.join("c.png"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 // ---------------------------------------------------------------------------
@@ -701,6 +827,35 @@ fn a_path_with_a_newline_keeps_messages_on_one_line() {
     std::fs::remove_file(&scene).unwrap();
     let e = one_error(&run(&["resume", s(&ck), "-q", "--spp", "4"]), 1);
     assert!(e.contains("a\\nb") && e.contains("cannot load its scene"), "{e}");
+    // Output paths checked up front (src/io/files.rs): a missing directory, an output
+    // that is an input, two outputs that are one file.
+    let scene = scene_in(&d, SCENE);
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("no\ndir/o.png"))]), 1);
+    assert!(e.contains("no\\ndir"), "{e}");
+    let e = one_error(&run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png")), "--checkpoint", s(&scene)]), 1);
+    assert!(e.contains("a\\nb") && e.contains("refusing to overwrite an input"), "{e}");
+    let e = one_error(
+        &run(&["render", s(&scene), "-q", "-o", s(&d.join("o.png")), "--checkpoint", s(&d.join("o.png"))]),
+        1,
+    );
+    assert!(e.contains("a\\nb") && e.contains("same file"), "{e}");
+    // Checkpoint paths in merge's messages (src/checkpoint.rs): overlapping parts, and
+    // parts of different scenes.
+    let part = |name: &str, passes: &str, scene: &Path| {
+        let ck = d.join(format!("{name}.ckpt"));
+        let png = d.join(format!("{name}.png"));
+        let o = run(&["render", s(scene), "-q", "-o", s(&png), "--checkpoint", s(&ck), "--passes", passes]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        ck
+    };
+    let (p, q) = (part("p", "0..2", &scene), part("q", "1..2", &scene));
+    let e = one_error(&run(&["merge", s(&p), s(&q), "-o", s(&d.join("m.png"))]), 1);
+    assert!(e.contains("overlap") && e.matches("a\\nb").count() == 2, "{e}");
+    let other = d.join("other.ron");
+    std::fs::write(&other, SCENE.replace("Constant(10)", "Constant(20)")).unwrap();
+    let r = part("r", "2..3", &other);
+    let e = one_error(&run(&["merge", s(&p), s(&r), "-o", s(&d.join("m.png"))]), 1);
+    assert!(e.contains("different scene") && e.matches("a\\nb").count() >= 3, "{e}");
 }
 
 /// Counts of one take the singular: "1 object, 1 light", "1 pass",
@@ -722,4 +877,59 @@ fn counts_of_one_are_singular() {
     let o = run(&["render", s(&scene), "-o", s(&d.join("o.png"))]);
     let err = stderr(&o);
     assert!(err.contains("1 bounce,") && err.contains("(2 passes in"), "{err}");
+}
+
+// ---------------------------------------------------------------------------
+// 16. Coincident surfaces (issue 34 item 17).
+
+/// Two dielectric objects with the same surface (glass and water spheres of one
+/// centre and radius): a ray meets only one of the two surfaces at each crossing, so the
+/// medium stack cannot follow. The README said the one listed first wins (a camera
+/// inside would see Y = n² = 2.25 for glass in a furnace of radiance 1, as for the
+/// glass sphere alone); measured, both orders and a higher water priority give exactly
+/// Y = 1, as if neither volume were there. The documented behaviour is now that: such a
+/// pair is not supported, and loading it warns naming both objects (before: no
+/// warning). A pair that overlaps without sharing the surface does not warn.
+#[test]
+fn coincident_dielectrics_warn_and_behave_as_documented() {
+    let enclosure = "(shape: Sphere(center: (0, 0, 0), radius: 10), emission: Constant(1), two_sided: true)";
+    let scene = |objects: &str| {
+        format!(
+            r#"(
+    camera: (eye: (0, 0, 0.2), look_at: (0, 0, -1), fov_deg: 30),
+    render: (width: 8, height: 8, spp: 2),
+    materials: {{ "glass": Dielectric(ior: Constant(1.5)), "water": Dielectric(ior: Constant(1.33)) }},
+    objects: [ {objects} {enclosure} ],
+)"#
+        )
+    };
+    let glass = r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"),"#;
+    let water = r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "water"),"#;
+    let water_first = r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "water", priority: 1),"#;
+    let mean_y = |text: &str| {
+        let film = furnace_film(text, "path", 4);
+        film.mean_xyz().iter().map(|p| p[1]).sum::<f64>() / (film.width() * film.height()) as f64
+    };
+    let alone = mean_y(&scene(glass));
+    assert!((alone - 2.25).abs() < 1e-3, "the glass sphere alone: {alone}");
+    for objects in [format!("{glass} {water}"), format!("{water} {glass}"), format!("{glass} {water_first}")] {
+        let y = mean_y(&scene(&objects));
+        assert!((y - 1.0).abs() < 1e-3, "{objects}: {y}");
+    }
+    let d = temp_dir("hostile-coincident");
+    let path = scene_in(&d, &scene(&format!("{glass} {water}")));
+    let o = run(&["render", s(&path), "-q", "-o", s(&d.join("o.png"))]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].starts_with("rust-v: warning: objects[0] and objects[1]") && lines[0].contains("same surface"),
+        "{err}"
+    );
+    // Overlapping volumes with priorities, the documented way, do not warn.
+    let inner = r#"(shape: Sphere(center: (0, 0, 0), radius: 0.9), material: "water", priority: 1),"#;
+    let path = scene_in(&d, &scene(&format!("{glass} {inner}")));
+    let o = run(&["render", s(&path), "-q", "-o", s(&d.join("o.png"))]);
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
 }

@@ -170,6 +170,67 @@ fn compare_reports_metrics_and_json() {
     assert!(!json.contains("inf") && !json.contains("NaN"), "{json}");
 }
 
+/// A PNG against an EXR (or the other way round): the PNG is clamped and sRGB-encoded,
+/// the EXR linear, so the linear metrics compare clamped against unclamped values (a
+/// render as PNG gave mse_lin 0.93 against its EXR reference, 0.0031 as EXR). One
+/// warning line on stderr names the metrics affected (issue 34 item 13); files of the
+/// same kind get none.
+#[test]
+fn compare_warns_when_a_png_meets_an_exr() {
+    let dir = temp_dir("compare-kinds");
+    let (png, exr, exr2) = (dir.join("a.png"), dir.join("ref.exr"), dir.join("b.exr"));
+    write_png(&png, 8, 8, 65535);
+    for p in [&exr, &exr2] {
+        image::ImageBuffer::<image::Rgb<f32>, Vec<f32>>::from_raw(8, 8, vec![2.0; 8 * 8 * 3])
+            .expect("size")
+            .save(p)
+            .expect("exr written");
+    }
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    for args in [vec![s(&png), s(&exr)], vec![s(&exr), s(&png)], vec![s(&png), s(&exr), "--json".into()]] {
+        let mut all = vec!["compare".to_owned()];
+        all.extend(args.iter().cloned());
+        let o = rust_v(&all.iter().map(String::as_str).collect::<Vec<_>>());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        let lines: Vec<&str> = err.lines().collect();
+        assert_eq!(lines.len(), 1, "{args:?}: {err}");
+        assert!(lines[0].starts_with("rust-v: warning: ") && lines[0].contains("a.png"), "{err}");
+        for metric in ["linear", "relMSE", "clamped"] {
+            assert!(lines[0].contains(metric), "{metric} not in {err}");
+        }
+    }
+    // The linear MSE the warning is about: the PNG's 1.0 against the EXR's 2.0.
+    let o = rust_v(&["compare", &s(&png), &s(&exr), "--json"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"mse_lin\": 1e0"), "{}", String::from_utf8_lossy(&o.stdout));
+    for (a, b) in [(&png, &png), (&exr, &exr2)] {
+        let o = rust_v(&["compare", &s(a), &s(b)]);
+        assert!(o.status.success() && o.stderr.is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    // converge measures linear renders: a PNG reference gets the same warning, an EXR none.
+    let scene = root().join("scenes/cornell.ron");
+    for (reference, warned) in [(&png, true), (&exr, false)] {
+        let out = dir.join("out");
+        let o = rust_v(&[
+            "converge",
+            &s(&scene),
+            "--reference",
+            &s(reference),
+            "--methods",
+            "path",
+            "--spp-schedule",
+            "1",
+            "--out",
+            &s(&out),
+            "--quiet",
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert_eq!(err.lines().count(), usize::from(warned), "{err}");
+        assert!(!warned || (err.contains("a.png") && err.contains("relMSE")), "{err}");
+    }
+}
+
 #[test]
 fn compare_errors_name_the_files() {
     let dir = temp_dir("compare-bad");

@@ -77,6 +77,7 @@ fn sobol_renders_are_deterministic_split_merged_and_resumed_exactly() {
             target_end: 7,
             output: "/tmp/x.png".into(),
             film: a.clone(),
+            inputs: Some(scene.input_hashes.clone()),
         };
         let back = Checkpoint::decode(&ckpt.encode().unwrap(), Path::new("a.ckpt")).unwrap();
         assert_eq!(back.settings.sampler, SamplerKind::Sobol, "the checkpoint records the sampler");

@@ -201,6 +201,40 @@ fn parse_pass_range(s: &str) -> Result<Range<u32>, Error> {
 /// The longest time a flag takes: a year, in seconds.
 pub const MAX_SECONDS: f64 = 365.25 * 24.0 * 3600.0;
 
+/// The message for a number flag's bad value: the library's parser says "a whole number
+/// from 0 to" the type's maximum; when the setting's own check takes a narrower interval
+/// (`--spp` from 1, `--width` up to 32768) say that one, found by asking the check, and
+/// when it takes a set that is no interval (`--packet-size`) say what the check says.
+fn not_a_number(name: &str, text: &str, message: String) -> String {
+    let type_max = message
+        .strip_prefix("expected a whole number from 0 to ")
+        .and_then(|rest| rest.split(',').next())
+        .and_then(|n| n.parse::<u64>().ok());
+    let Some(type_max) = type_max else { return message };
+    let ok = |v: u64| SettingsPatch::default().set(name, &v.to_string()).is_ok();
+    let Some(lo) = [0, 1].into_iter().find(|&v| ok(v)) else { return message };
+    // The largest value taken (a binary search, right for an interval from `lo`).
+    let (mut good, mut bad) = (lo, type_max);
+    if ok(type_max) {
+        good = type_max;
+    }
+    while bad - good > 1 {
+        let mid = good + (bad - good) / 2;
+        if ok(mid) { good = mid } else { bad = mid }
+    }
+    let interval = [lo + 1, lo + 2, lo + (good - lo) / 3, lo + (good - lo) / 2].into_iter().all(|v| v > good || ok(v));
+    if interval {
+        return format!("expected a whole number from {lo} to {good}, found {text:?}");
+    }
+    // Not an interval (`--packet-size`): what the check says of a refused value.
+    match SettingsPatch::default().set(name, "0") {
+        Err(Error::Setting { message: m, .. }) => {
+            format!("{}, found {text:?}", m.split(", found").next().unwrap_or(&m))
+        }
+        _ => message,
+    }
+}
+
 /// A positive, finite number of seconds, at most [`MAX_SECONDS`].
 fn parse_seconds(s: &str) -> Result<f64, Error> {
     match s.trim().parse::<f64>() {
@@ -245,7 +279,7 @@ impl Args for SettingsArgs {
                 arg.value_parser(move |s: &str| {
                     SettingsPatch::default().set(name, s).map(|()| s.to_string()).map_err(|e| match e {
                         // clap names the flag; the message says what was expected.
-                        Error::Setting { message, .. } => Error::Settings(message),
+                        Error::Setting { message, .. } => Error::Settings(not_a_number(name, s, message)),
                         e => e,
                     })
                 })

@@ -54,23 +54,27 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
             "--spectral keeps the 36 bin centres, so it cannot follow --wavelengths continuous (use hero)".into(),
         ));
     }
+    // With a time budget and no --spp (or --passes), render until the time is up.
+    let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     if !args.run.quiet {
+        let spp = match (&args.passes, args.time) {
+            (Some(p), _) => format!("passes {}..{} of {} spp", p.start, p.end, s.spp),
+            (None, Some(t)) if open_ended => format!("as many passes as {t} s allow"),
+            _ => format!("{} spp", s.spp),
+        };
         say(format_args!(
-            "{} ({}, {}, loaded in {:.2} s): {}x{}, {} spp, {}, seed {}",
+            "{} ({}, {}, loaded in {:.2} s): {}x{}, {spp}, {}, seed {}",
             show_path(&args.scene),
             count(scene.object_count() as u64, "object"),
             count(scene.lights.len() as u64, "light"),
             load_time.as_secs_f64(),
             s.width,
             s.height,
-            s.spp,
             count(s.max_bounces, "bounce"),
             s.seed,
         ));
         say(format_args!("{}", rust_v::integrator::describe(&scene)));
     }
-    // With a time budget and no --spp (or --passes), render until the time is up.
-    let open_ended = args.time.is_some() && !args.settings.spp_given() && args.passes.is_none();
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output));
     check_files(&args.scene, &scene, &[], &output, &checkpoint_path, args.spectral)?;
@@ -87,6 +91,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         } else {
             Film::starting_at(s.width, s.height, passes.start)
         },
+        inputs: Some(scene.input_hashes.clone()),
     };
     checkpoint.film.set_color_space(args.color_space);
     let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, args.time);
@@ -111,7 +116,7 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
         None => ckpt.target_end,
     };
     if args.spp.is_some() {
-        ckpt.settings.spp = end - done.start;
+        ckpt.settings.spp = end.max(done.end) - done.start;
     }
     let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
     check_output_extension(&output)?;
@@ -119,24 +124,40 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     ckpt.film.set_color_space(args.color_space);
     let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?;
-    if scene.content_hash != ckpt.content_hash && args.force {
-        warn(format_args!("{}; resuming anyway (--force)", changed_inputs(path, &ckpt.scene_path, &scene.inputs)));
+    if scene.content_hash != ckpt.content_hash {
+        let changed = match &ckpt.inputs {
+            Some(old) => {
+                let names = rust_v::checkpoint::changed_inputs(old, &scene.input_hashes, &ckpt.scene_path);
+                format!("{} changed since the checkpoint was written", names.join(", "))
+            }
+            None => changed_inputs(path, &ckpt.scene_path, &scene.inputs),
+        };
+        if !args.force {
+            return Err(Error::checkpoint(
+                path,
+                format!(
+                    "{changed} (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
+                    scene.content_hash, ckpt.content_hash
+                ),
+            ));
+        }
+        warn(format_args!("{changed}; resuming anyway (--force)"));
         ckpt.content_hash = scene.content_hash;
     }
-    if scene.content_hash != ckpt.content_hash {
-        return Err(Error::checkpoint(
-            path,
-            format!(
-                "{} (content hash {:016x}, was {:016x}); resuming needs the same inputs (or --force)",
-                changed_inputs(path, &ckpt.scene_path, &scene.inputs),
-                scene.content_hash,
-                ckpt.content_hash
-            ),
-        ));
-    }
+    // From here on the checkpoint records the scene's inputs as they are (an older
+    // version's checkpoint gains its per-input hashes).
+    ckpt.inputs = Some(scene.input_hashes.clone());
     if scene.settings != ckpt.settings {
         let diffs = scene.settings.differences(&ckpt.settings).join(", ");
         return Err(Error::checkpoint(path, format!("its settings load differently: {diffs}")));
+    }
+    if let Some(spp) = args.spp.filter(|_| end <= done.end && !args.run.quiet) {
+        // Nothing to render: say why, then write the image of the passes held.
+        say(format_args!(
+            "the checkpoint already holds {}; --spp {spp} asks for {}: nothing to render",
+            count(done.end - done.start, "pass"),
+            if end < done.end { "fewer" } else { "no more" }
+        ));
     }
     if !args.run.quiet {
         say(format_args!(
@@ -169,7 +190,8 @@ fn same_file(a: &Path, b: &Path) -> bool {
     a == b || matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
 }
 
-/// Says which inputs of a resumed scene changed, as far as can be told. The
+/// Says which inputs of a resumed scene changed, as far as can be told, for a
+/// checkpoint of version 1 to 4 (a newer one has each input's hash). Such a
 /// checkpoint stores one hash over the scene file and every file it reads
 /// (meshes, data), not one per file, so: a scene that reads no other file
 /// changed itself; otherwise the inputs modified after the checkpoint file
@@ -312,8 +334,9 @@ fn check_files(
 }
 
 /// Warns about what the scene asks for that cannot happen: a `priority` on an
-/// object that is not a dielectric (only dielectric volumes nest), and a
-/// scene without any light (the image is black).
+/// object that is not a dielectric (only dielectric volumes nest), two
+/// dielectrics with the same surface, and a scene without any light (the
+/// image is black).
 fn warn_no_effect(scene: &Scene) {
     for (i, o) in scene.objects.iter().enumerate() {
         let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
@@ -321,6 +344,21 @@ fn warn_no_effect(scene: &Scene) {
             warn(format_args!(
                 "objects[{i}].priority: {} has no effect: the object is not a dielectric, and only dielectric volumes nest by priority",
                 o.priority
+            ));
+        }
+    }
+    // Two dielectric objects with the same surface: a ray meets one of the two surfaces
+    // at each crossing, so the medium stack cannot follow (measured: coincident glass and
+    // water spheres act as neither). Shapes compared exactly; meshes are not compared.
+    let mut seen = std::collections::HashMap::new();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
+        if !dielectric || matches!(o.shape, rust_v::shape::Shape::Mesh(_)) {
+            continue;
+        }
+        if let Some(first) = seen.insert(format!("{:?}", o.shape), i) {
+            warn(format_args!(
+                "objects[{first}] and objects[{i}] are dielectrics with the same surface: a ray meets only one of two coincident surfaces, so neither volume is rendered right; make one volume overlap the other and give it a higher priority (docs/scene-format.md, Nested dielectrics)"
             ));
         }
     }

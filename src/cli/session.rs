@@ -165,8 +165,9 @@ impl Session {
                 view.warn(format_args!("{e}"));
             }
             let saved = save_work(&ckpt, plan, None)?;
-            if let Ok(msg) = snapshot {
-                view.note(format_args!("stopped by a signal: {msg}"));
+            match snapshot {
+                Ok(msg) => view.note(format_args!("stopped by a signal: {msg} and checkpoint {}", show_path(&saved))),
+                Err(_) => view.note(format_args!("stopped by a signal: wrote checkpoint {}", show_path(&saved))),
             }
             view.note(format_args!("continue with: rust-v resume {}", show_path(&saved)));
         }

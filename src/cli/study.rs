@@ -15,7 +15,7 @@ use rust_v::study::converge::{self, Method, Record, SUMMARY_METRICS, Schedule, S
 use rust_v::study::metrics::{Image, Metrics, Ratios, Source, THESIS_L, firefly_share, measure};
 
 use super::args::{CompareArgs, ConvergeArgs};
-use super::console::{out, say, thread_pool};
+use super::console::{out, say, thread_pool, warn};
 
 /// Reads both images and measures `a` against `b`; errors name the file(s).
 fn compare_files(a: &Path, b: &Path) -> Result<(Image, Image, Metrics)> {
@@ -64,9 +64,26 @@ fn json_str(s: &str) -> String {
     o
 }
 
+/// Warns (one line) when one file is a PNG (clamped, sRGB-encoded, quantised) and the
+/// other linear (EXR): the linear metrics then compare clamped against unclamped values,
+/// while the 16-bit-code metrics compare like with like (the EXR is encoded as rust-v
+/// writes a PNG).
+fn warn_mixed_sources(a: &Path, sa: Source, b: &Path, sb: Source) {
+    if sa == sb {
+        return;
+    }
+    let (png, exr) = if sa == Source::Encoded { (a, b) } else { (b, a) };
+    warn(format_args!(
+        "{} is a PNG (clamped to [0, 1], sRGB-encoded, 16-bit) and {} linear: the linear metrics (linear MSE and PSNR, relMSE, mean relative errors, firefly share) compare clamped against unclamped values; the 16-bit sRGB metrics (MSE, PSNR, SSIM, variance, windowed SSIM) compare like with like; use EXR files for linear errors",
+        show_path(png),
+        show_path(exr)
+    ));
+}
+
 /// `rust-v compare A B [--json]`.
 pub fn compare_command(args: CompareArgs) -> Result<()> {
     let (ia, ib, m) = compare_files(&args.a, &args.b)?;
+    warn_mixed_sources(&args.a, ia.source, &args.b, ib.source);
     let src = |s: Source| if s == Source::Linear { "linear" } else { "srgb16" };
     if args.json {
         let fields = [
@@ -162,6 +179,8 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
             reference.height
         )));
     }
+    // The renders are measured as linear images (like an EXR).
+    warn_mixed_sources(Path::new("the renders"), Source::Linear, &args.reference, reference.source);
     let schedule = match (&args.time, &args.spp_schedule) {
         (Some(t), _) => Schedule::Time(Duration::from_secs_f64(*t)),
         (None, Some(v)) => Schedule::Spp(v.clone()),

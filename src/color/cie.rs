@@ -192,6 +192,7 @@ impl Spectrum {
 mod tests {
     use super::*;
     use crate::color::spectrum::{Spectrum, bin_lambda_nm};
+    use crate::error::show_path;
     use std::path::Path;
 
     #[test]
@@ -209,7 +210,7 @@ mod tests {
     fn y_bar_555_is_one_in_5nm_table() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/cmf_1931_2deg_360_830_5nm.csv");
         let Ok(text) = std::fs::read_to_string(&path) else {
-            println!("skipping: {} not found", path.display());
+            println!("skipping: {} not found", show_path(&path));
             return;
         };
         let mut found = None;

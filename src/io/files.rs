@@ -19,7 +19,7 @@ use std::fs::OpenOptions;
 use std::path::{Path, PathBuf};
 
 use super::atomic_file::{NAME_MAX, temp_path};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, show_path};
 
 /// Reads a whole input file, refusing anything but a regular file (checked
 /// with `stat` first, so a FIFO never blocks the read).
@@ -35,7 +35,7 @@ pub fn check_regular(path: &Path) -> Result<()> {
         return Ok(());
     }
     let what = if meta.is_dir() { "a directory" } else { kind_of_special(&meta) };
-    Err(Error::Settings(format!("{}: is {what}; expected a regular file", path.display())))
+    Err(Error::Settings(format!("{}: is {what}; expected a regular file", show_path(path))))
 }
 
 #[cfg(unix)]
@@ -63,7 +63,7 @@ fn kind_of_special(_: &std::fs::Metadata) -> &'static str {
 /// file, and nothing but a regular file already has the name. `role` names
 /// the output in errors (`image`, `checkpoint`, ...).
 pub fn check_output(path: &Path, role: &str) -> Result<()> {
-    let bad = |m: String| Error::Settings(format!("{role} {}: {m}", path.display()));
+    let bad = |m: String| Error::Settings(format!("{role} {}: {m}", show_path(path)));
     let name = path.file_name().ok_or_else(|| bad("expected a file name".into()))?;
     if name.len() > NAME_MAX {
         return Err(bad(format!("the name is {} bytes long; at most {NAME_MAX} are allowed", name.len())));
@@ -84,8 +84,8 @@ pub fn check_output(path: &Path, role: &str) -> Result<()> {
     let dir = parent_dir(path);
     match std::fs::metadata(dir) {
         Ok(m) if m.is_dir() => {}
-        Ok(_) => return Err(bad(format!("{} is not a directory", dir.display()))),
-        Err(e) => return Err(bad(format!("its directory {}: {e}", dir.display()))),
+        Ok(_) => return Err(bad(format!("{} is not a directory", show_path(dir)))),
+        Err(e) => return Err(bad(format!("its directory {}: {e}", show_path(dir)))),
     }
     // Probe with the temporary name the atomic write will use.
     let tmp = temp_path(path);
@@ -96,7 +96,7 @@ pub fn check_output(path: &Path, role: &str) -> Result<()> {
             Ok(())
         }
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
-        Err(e) => Err(bad(format!("cannot create a file in {}: {e}", dir.display()))),
+        Err(e) => Err(bad(format!("cannot create a file in {}: {e}", show_path(dir)))),
     }
 }
 
@@ -140,8 +140,8 @@ pub fn check_aliasing(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
             if identity(in_path).as_ref() == Some(id) {
                 return Err(Error::Settings(format!(
                     "{role} {} is the {in_role} {}: refusing to overwrite an input",
-                    path.display(),
-                    in_path.display()
+                    show_path(path),
+                    show_path(in_path)
                 )));
             }
         }
@@ -149,8 +149,8 @@ pub fn check_aliasing(inputs: &[(&str, &Path)], outputs: &[(&str, &Path)]) -> Re
             if ids[j].as_ref() == Some(id) {
                 return Err(Error::Settings(format!(
                     "{role} {} and {other_role} {} are the same file",
-                    path.display(),
-                    other.display()
+                    show_path(path),
+                    show_path(other)
                 )));
             }
         }

@@ -59,6 +59,10 @@ fn load(text: &str, bytes: &[u8], path: &Path, overrides: &SettingsPatch) -> Res
     let mut scene = build(&ctx, desc, overrides).map_err(|e| locate(e, text))?;
     let inputs = ctx.inputs.into_inner();
     scene.content_hash = content_hash(bytes, &inputs);
+    scene.input_hashes = crate::checkpoint::InputHashes {
+        scene: fnv1a(bytes),
+        files: inputs.iter().map(|i| (i.name.clone(), i.hash)).collect(),
+    };
     scene.inputs = inputs.into_iter().map(|i| i.path).collect();
     Ok(scene)
 }

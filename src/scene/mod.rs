@@ -101,6 +101,9 @@ pub struct Scene {
     /// Every file the scene reads besides itself (meshes, data files), as
     /// resolved paths: no output may overwrite one.
     pub inputs: Vec<std::path::PathBuf>,
+    /// The hash of the scene file and of each file it reads, for naming the inputs
+    /// that changed when a checkpoint is resumed.
+    pub input_hashes: crate::checkpoint::InputHashes,
 }
 
 impl Scene {
@@ -177,6 +180,7 @@ impl Scene {
             batch,
             content_hash,
             inputs: Vec::new(),
+            input_hashes: Default::default(),
         }
     }
 
