@@ -84,7 +84,7 @@ cd "$copy"
 echo "building the mutated copy in $copy (CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$copy/target})" >&2
 cargo test --locked --test main --no-run 2>"$out/build.log" || { tail -30 "$out/build.log" >&2; exit 1; }
 
-failed() { grep -E '^test .* \.\.\. FAILED$' "$1" | sed -E 's/^test (.*) \.\.\. FAILED$/\1/' | sort; }
+failed() { { grep -E '^test .* \.\.\. FAILED$' "$1" || true; } | sed -E 's/^test (.*) \.\.\. FAILED$/\1/' | sort; }
 
 for mutant in none whitted path hero random continuous auto bdpt lighttrace; do
     start=$(date +%s)
