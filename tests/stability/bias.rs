@@ -153,3 +153,25 @@ fn dispersive_glass_detects_a_one_percent_bias() {
 fn bdpt_sphere_furnace_is_biased() {
     check("white furnace ρ 0.5 (sphere)", "bdpt", over_seeds(FURNACE, "bdpt", 256), 2.0);
 }
+
+/// A second bug found beside the first, recorded: a closed *one-sided*
+/// emitting sphere (`two_sided: false`: it emits outward only) seen from
+/// inside must give exactly 0 (no light inside, and the cube built the same
+/// way gives exactly 0 with every method), but light sampled on the sphere
+/// leaks in: 16 seeds of 8x8 at 32 spp, ρ 0.5, give `whitted` 0.2587 ±
+/// 0.0016, `path` 0.1040 ± 0.0006 at `max_bounces: 1` and 0.2038 ± 0.0008
+/// with all bounces, `bdpt` 0.00075 ± 0.00001, `lighttrace` exactly 0 (it
+/// starts on the emitting side). Next-event estimation on a sphere light
+/// from a point inside it appears to ignore which side emits; it may share
+/// a cause with [`bdpt_sphere_furnace_is_biased`] (the sphere's density
+/// seen from inside). Ignored until fixed; run with `-- --ignored`.
+#[test]
+#[ignore = "a one-sided sphere emitter leaks light inside through light sampling (a bug, see the doc)"]
+fn one_sided_sphere_emitter_is_dark_inside() {
+    let scene = FURNACE.replace("two_sided: true", "two_sided: false");
+    for m in ["whitted", "path", "bdpt", "lighttrace"] {
+        let (mean, se) = over_seeds(&scene, m, 32);
+        eprintln!("one-sided sphere emitter seen from inside, {m}: Y = {mean:.5} ± {se:.5}, want 0");
+        assert_eq!(mean, 0.0, "{m}: {mean} ± {se}");
+    }
+}
