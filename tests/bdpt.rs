@@ -37,18 +37,42 @@ fn render_into(scene: &Scene, film: &mut Film, passes: std::ops::Range<u32>) {
     assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
 }
 
-/// Mean and standard error, per block, over renders with different seeds.
-fn seeded_blocks(text: &str, integrator: IntegratorKind, size: u32, spp: u32, seeds: u64) -> Vec<(f64, f64)> {
+/// Mean and standard error, per 4x4 block, over renders with different seeds;
+/// and of the image sum (the sum of a render's block means), whose standard
+/// error comes from the seeds too (blocks of one render can be correlated:
+/// a light subpath splats into several).
+fn seeded_blocks(
+    text: &str,
+    integrator: IntegratorKind,
+    size: u32,
+    spp: u32,
+    seeds: u64,
+) -> (Vec<(f64, f64)>, (f64, f64)) {
     let runs: Vec<Vec<f64>> =
         (0..seeds).map(|s| block_means(&render_str(text, &settings(integrator, size, spp, 100 + s)), 4)).collect();
     let n = seeds as f64;
-    (0..runs[0].len())
-        .map(|k| {
-            let m = runs.iter().map(|r| r[k]).sum::<f64>() / n;
-            let var = runs.iter().map(|r| (r[k] - m).powi(2)).sum::<f64>() / (n - 1.0);
-            (m, (var / n).sqrt())
-        })
-        .collect()
+    let stats = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+        (m, (var / n).sqrt())
+    };
+    let blocks = (0..runs[0].len()).map(|k| stats(&runs.iter().map(|r| r[k]).collect::<Vec<_>>())).collect();
+    let sums: Vec<f64> = runs.iter().map(|r| r.iter().sum()).collect();
+    (blocks, stats(&sums))
+}
+
+/// Asserts two image sums (mean, s.e. from seeds) within 4.5 combined s.e.;
+/// prints the difference and the smallest relative bias detected with
+/// probability ≥ 97.7%, (4.5 + 2) combined s.e.
+fn assert_same_sum(what: &str, (sa, sea): (f64, f64), (sb, seb): (f64, f64)) {
+    let se = (sea * sea + seb * seb).sqrt();
+    eprintln!(
+        "{what}: image sum {sa:.4} ± {sea:.4} vs {sb:.4} ± {seb:.4}, differ {:+.2}%, s.e. {:.2}%, detects ≥ {:.1}%",
+        100.0 * (sa / sb - 1.0),
+        100.0 * se / sb,
+        100.0 * 6.5 * se / sb
+    );
+    assert!((sa - sb).abs() < 4.5 * se, "{what}: image sum {sa} vs {sb} (se {se})");
 }
 
 fn scene_text(name: &str) -> String {
@@ -59,12 +83,14 @@ fn scene_text(name: &str) -> String {
 /// BDPT, light tracing and path tracing are unbiased for the same image:
 /// on the Cornell box (all diffuse: every method sees every path), each
 /// 4×4 block's Y from 32 one-spp BDPT renders (seeds differ: the mean of
-/// 1-spp renders, so bias at low sample counts would show), from 16 light
-/// tracing renders of 4 spp, and from 16 path tracing renders of 4 spp
+/// 1-spp renders, so bias at low sample counts would show), from 64 light
+/// tracing renders of 16 spp, and from 64 path tracing renders of 16 spp
 /// agree within 4.5 combined standard errors (estimated from the seeds'
 /// spread), which 64 blocks × 2 comparisons pass by chance with
 /// probability > 99.9%; and the image sums within 4.5 combined standard
-/// errors (the blocks' errors added in quadrature). A fixed 1% on the image
+/// errors, from the seeds' image sums ([`assert_same_sum`]; it was the
+/// blocks' errors in quadrature from 32 one-spp BDPT renders and 16 of 4 spp,
+/// 0.5% s.e., detecting 3.5%: about the issue's "10%" of a one-spp check). A fixed 1% on the image
 /// mean was here before the sobol sampler: that realization of light
 /// tracing landed 1.2% above path (48 seeds: 0.2804 ± 0.0008 against path's
 /// 0.2785 ± 0.0016, 1.1 standard errors, with the independent sampler
@@ -72,10 +98,9 @@ fn scene_text(name: &str) -> String {
 #[test]
 fn bdpt_lighttrace_and_path_agree_on_the_cornell_box() {
     let text = scene_text("cornell.ron");
-    let path = seeded_blocks(&text, IntegratorKind::Path, 32, 4, 16);
-    for (integrator, spp, seeds) in [(IntegratorKind::Bdpt, 1, 32), (IntegratorKind::LightTrace, 4, 16)] {
-        let other = seeded_blocks(&text, integrator, 32, spp, seeds);
-        let (mut sa, mut sb, mut var) = (0.0, 0.0, 0.0);
+    let (path, path_sum) = seeded_blocks(&text, IntegratorKind::Path, 32, 16, 64);
+    for (integrator, spp, seeds) in [(IntegratorKind::Bdpt, 1, 512), (IntegratorKind::LightTrace, 16, 64)] {
+        let (other, other_sum) = seeded_blocks(&text, integrator, 32, spp, seeds);
         for (k, (a, b)) in other.iter().zip(&path).enumerate() {
             let se = (a.1 * a.1 + b.1 * b.1).sqrt();
             assert!(
@@ -84,29 +109,34 @@ fn bdpt_lighttrace_and_path_agree_on_the_cornell_box() {
                 a.0,
                 b.0
             );
-            sa += a.0;
-            sb += b.0;
-            var += se * se;
         }
-        let se = var.sqrt();
-        assert!((sa - sb).abs() < 4.5 * se, "{integrator:?}: image sum {sa} vs path {sb} (se {se})");
+        assert_same_sum(&format!("cornell, {integrator:?} vs path"), other_sum, path_sum);
     }
 }
 
 /// 4x4 blocks of 12 BDPT renders (4 spp) and 12 `auto` renders (8 spp) of a
 /// 16x16 view agree within 4.5 combined s.e. (from the seeds' spread), the
-/// image means within 3%. Returns `auto`'s sum of block means.
-fn bdpt_agrees_with_auto(text: &str) -> f64 {
-    let auto = seeded_blocks(text, IntegratorKind::Auto, 16, 8, 12);
-    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 4, 12);
-    let (mut sa, mut sb) = (0.0, 0.0);
+/// image means within 3%. That is only about 2 combined s.e. of the image
+/// sums from the seeds (1.3% on the glass spheres, 1.4% in the glass of
+/// water: glass fireflies), tighter than 4.5 s.e. would be, and kept: it
+/// passes with these seeds, and any change of the random numbers that makes
+/// it fail should be looked at, not the bound widened. Returns `auto`'s sum
+/// of block means.
+fn bdpt_agrees_with_auto(text: &str, what: &str) -> f64 {
+    let (auto, auto_sum) = seeded_blocks(text, IntegratorKind::Auto, 16, 8, 12);
+    let (bdpt, bdpt_sum) = seeded_blocks(text, IntegratorKind::Bdpt, 16, 4, 12);
     for (k, (a, b)) in bdpt.iter().zip(&auto).enumerate() {
         let se = (a.1 * a.1 + b.1 * b.1).sqrt();
         assert!((a.0 - b.0).abs() <= 4.5 * se + 1e-4, "block {k}: bdpt {:.4} vs auto {:.4} (se {se:.4})", a.0, b.0);
-        sa += a.0;
-        sb += b.0;
     }
-    assert!((sa / sb - 1.0).abs() < 0.03, "image mean {sa} vs auto {sb}");
+    let (sa, sb) = (bdpt_sum.0, auto_sum.0);
+    let se = (bdpt_sum.1.powi(2) + auto_sum.1.powi(2)).sqrt();
+    eprintln!(
+        "{what}, bdpt vs auto: image sum {sa:.4} vs {sb:.4}, differ {:+.2}%, s.e. {:.2}% (from the seeds)",
+        100.0 * (sa / sb - 1.0),
+        100.0 * se / sb
+    );
+    assert!((sa / sb - 1.0).abs() < 0.03, "{what}: image sum {sa} vs auto {sb}");
     sb
 }
 
@@ -117,9 +147,8 @@ fn bdpt_agrees_with_auto(text: &str) -> f64 {
 #[test]
 fn bdpt_agrees_with_auto_on_the_glass_spheres() {
     let text = scene_text("spheres.ron");
-    let sb = bdpt_agrees_with_auto(&text);
-    let light = seeded_blocks(&text, IntegratorKind::LightTrace, 16, 8, 4);
-    let sl: f64 = light.iter().map(|b| b.0).sum();
+    let sb = bdpt_agrees_with_auto(&text, "glass spheres");
+    let sl = seeded_blocks(&text, IntegratorKind::LightTrace, 16, 8, 4).1.0;
     assert!(sl < 0.99 * sb && sl > 0.5 * sb, "light tracing {sl} vs auto {sb}");
 }
 
@@ -135,7 +164,7 @@ fn bdpt_agrees_with_auto_on_the_glass_spheres() {
 #[test]
 fn bdpt_agrees_with_auto_among_nested_dielectrics() {
     let text = scene_text("glass-of-water.ron");
-    bdpt_agrees_with_auto(&text);
+    bdpt_agrees_with_auto(&text, "glass of water");
 }
 
 /// A diffuse floor (ρ = 0.5) under a point light of intensity 2 at height 1
@@ -146,6 +175,19 @@ fn bdpt_agrees_with_auto_among_nested_dielectrics() {
 /// next-event estimation and light tracing) within 4% at 1024 spp: over 8
 /// seeds its quadrant sums (falloff band excluded) spread by 2.7-6.0% at 64
 /// spp and 0.7-2.1% at 256, so about 0.4-1.1% here and 4% is > 3.5 sigma.
+/// The whole image (every pixel with a closed form) against the closed form,
+/// over 8 seeds of 1024 spp, within 4 s.e. (from the seeds) + 0.2% (the
+/// closed form is taken at pixel centres, the render averages each pixel's
+/// footprint: measured −0.07% for the point light and −0.11% for the spot,
+/// the same for both methods): ratios 0.99934 ± 0.00004 (light tracing) and
+/// 0.99935 ± 0.00000 (bdpt) for the point light, 0.99886 ± 0.00008 and
+/// 0.99887 ± 0.00007 for the spot; detects a bias of 0.25% (6 s.e. + 0.2%).
+/// The s.e. is this small because the sobol sampler stratifies the light's
+/// directions (which pixels are hit is nearly fixed) and BDPT's connections
+/// to a point light vary only with the pixel jitter.
+/// Independent seeds for the whole-image check of [`delta_lights_give_the_closed_form_irradiance_by_light_tracing_and_bdpt`].
+const SEEDS: u64 = 8;
+
 #[test]
 fn delta_lights_give_the_closed_form_irradiance_by_light_tracing_and_bdpt() {
     let base = r#"(
@@ -173,8 +215,9 @@ fn delta_lights_give_the_closed_form_irradiance_by_light_tracing_and_bdpt() {
     ];
     for (light, falloff) in &cases {
         let text = base.replace("LIGHT", light);
-        let o = settings(IntegratorKind::LightTrace, 16, 1024, 1);
-        let scene = load_scene_str(&text, std::path::Path::new("t.ron"), &o).unwrap();
+        let scene =
+            load_scene_str(&text, std::path::Path::new("t.ron"), &settings(IntegratorKind::LightTrace, 16, 1024, 1))
+                .unwrap();
         let want: Vec<Option<f64>> = (0..256)
             .map(|k| {
                 let (x, y) = ((k % 16) as f32 + 0.5, (k / 16) as f32 + 0.5);
@@ -186,19 +229,40 @@ fn delta_lights_give_the_closed_form_irradiance_by_light_tracing_and_bdpt() {
                 falloff(cos).map(|f| 0.5 * 2.0 * f * cos / r2 / PI)
             })
             .collect();
-        let lt = render_str(&text, &o).mean_xyz();
-        let bd = render_str(&text, &settings(IntegratorKind::Bdpt, 16, 1024, 1)).mean_xyz();
-        for (name, img, tol) in [("light tracing", &lt, 0.06), ("bdpt", &bd, 0.04)] {
-            for q in 0..4 {
-                let (mut got, mut exp) = (0.0, 0.0);
-                for k in (0..256).filter(|k| (k % 16 >= 8) as usize + 2 * ((k / 16 >= 8) as usize) == q) {
-                    if let Some(w) = want[k] {
-                        got += img[k][1];
-                        exp += w;
+        // Each method's ratio of the whole image to the closed form (the pixels that
+        // have one), per seed, and per quadrant for the first seed.
+        for (name, integrator, tol) in
+            [("light tracing", IntegratorKind::LightTrace, 0.06), ("bdpt", IntegratorKind::Bdpt, 0.04)]
+        {
+            let ratios: Vec<f64> = (0..SEEDS)
+                .map(|seed| {
+                    let img = render_str(&text, &settings(integrator, 16, 1024, 1 + seed)).mean_xyz();
+                    let (mut got, mut exp) = (0.0, 0.0);
+                    for q in 0..4 {
+                        let (mut gq, mut eq) = (0.0, 0.0);
+                        for k in (0..256).filter(|k| (k % 16 >= 8) as usize + 2 * ((k / 16 >= 8) as usize) == q) {
+                            if let Some(w) = want[k] {
+                                gq += img[k][1];
+                                eq += w;
+                            }
+                        }
+                        if seed == 0 {
+                            assert!((gq - eq).abs() <= tol * eq + 1e-3, "{light}: {name} quadrant {q}: {gq} vs {eq}");
+                        }
+                        got += gq;
+                        exp += eq;
                     }
-                }
-                assert!((got - exp).abs() <= tol * exp + 1e-3, "{light}: {name} quadrant {q}: {got} vs {exp}");
-            }
+                    got / exp
+                })
+                .collect();
+            let n = SEEDS as f64;
+            let mean = ratios.iter().sum::<f64>() / n;
+            let se = (ratios.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+            eprintln!(
+                "{light}: {name} image / closed form {mean:.5} ± {se:.5} ({SEEDS} seeds), detects ≥ {:.2}%",
+                100.0 * (6.0 * se + 2e-3)
+            );
+            assert!((mean - 1.0).abs() < 4.0 * se + 2e-3, "{light}: {name} image / closed form {mean} ± {se}");
         }
     }
 }

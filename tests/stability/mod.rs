@@ -10,6 +10,7 @@
 use rust_v::film::Film;
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
+mod bias;
 mod glass;
 mod lighttrace;
 mod materials;
