@@ -44,16 +44,21 @@ impl SphereLight {
         let to_c = sphere.center - p;
         let d2 = to_c.length_squared();
         let r2 = sphere.radius * sphere.radius;
-        if d2 <= r2 {
-            if !self.two_sided {
-                // Inside a sphere that emits outward: nothing to see.
-                return None;
-            }
-            // Inside: uniform by area, converted to solid angle.
+        if by_area(d2, r2) {
+            // Inside, or on the sphere within rounding: uniform by area,
+            // converted to solid angle.
             let n = uniform_sphere(u);
             let point = sphere.center + n * sphere.radius;
             let d = point - p;
+            // A one-sided sphere emits outward only: nothing from a point whose
+            // outside does not face `p` (every point, seen from inside).
+            if !self.two_sided && d.dot(n) >= 0.0 {
+                return None;
+            }
             let dist2 = d.length_squared();
+            if dist2.is_nan() || dist2 <= 0.0 {
+                return None;
+            }
             let wi = d / dist2.sqrt();
             let cos_l = wi.dot(n).abs();
             if cos_l == 0.0 {
@@ -89,17 +94,36 @@ impl SphereLight {
         let sphere = &self.sphere;
         let d2 = (sphere.center - p).length_squared();
         let r2 = sphere.radius * sphere.radius;
-        if d2 <= r2 {
-            if !self.two_sided {
+        if by_area(d2, r2) {
+            let n = (point - sphere.center) / sphere.radius;
+            if !self.two_sided && (point - p).dot(n) >= 0.0 {
                 return 0.0;
             }
-            let n = (point - sphere.center) / sphere.radius;
             let cos_l = wi.dot(n).abs();
             return (point - p).length_squared() / (cos_l * 4.0 * PI * r2);
         }
         1.0 / (2.0 * PI * cone_one_minus_cos(r2 / d2))
     }
 }
+
+/// Whether a shading point at squared distance `d2` from the centre of a
+/// sphere of squared radius `r2` samples the sphere by area (inside it, or on
+/// it within rounding: [`ON_SPHERE`]) rather than by the cone it subtends
+/// (outside). A point on the sphere itself (a path scattering on the emitting
+/// sphere, or a furnace made of it) is inside or outside only by rounding; the
+/// cone there is a hemisphere whose sampled point is `p` itself, at distance 0,
+/// which made BDPT 11.5% dark in a two-sided sphere furnace and let a
+/// one-sided sphere light its own inside. Area sampling is right from
+/// anywhere (the sphere's far side is occluded by the sphere), so the band
+/// only trades a little variance for points just outside.
+#[inline]
+fn by_area(d2: f32, r2: f32) -> bool {
+    d2 <= r2 * (1.0 + ON_SPHERE)
+}
+
+/// The relative band of squared distance around the sphere treated as on it
+/// (1e-4: points within 5e-5 radii; hit points lie within about 1e-6).
+const ON_SPHERE: f32 = 1e-4;
 
 /// `1 − cos θmax` of the cone a sphere subtends, from `sin² θmax = r² / d²`,
 /// as `sin² / (1 + cos)`: exact to rounding at any size, where `1 − sqrt(1 − sin²)`

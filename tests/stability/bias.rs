@@ -70,8 +70,8 @@ fn check(what: &str, m: &str, (mean, se): (f64, f64), want: f64) -> f64 {
 /// The white furnace (as `tests/furnace.rs`): a closed Lambertian sphere of
 /// albedo 0.5 emitting L_e = 1 (equal energy, Y = 1) on both sides, the
 /// camera inside: L = L_e / (1 − ρ) = 2 in every pixel and direction (the
-/// Neumann series L_e Σ ρᵏ). `bdpt` is biased there (see
-/// [`bdpt_sphere_furnace_is_biased`]) and runs in [`BOX_FURNACE`].
+/// Neumann series L_e Σ ρᵏ). `bdpt` was biased there until a fix (see
+/// [`bdpt_sphere_furnace_gives_two`]) and its 1% test runs in [`BOX_FURNACE`].
 const FURNACE: &str = r#"(
     camera: (eye: (0.1, -0.2, 0.3), look_at: (1, 0.5, -0.3), fov_deg: 70),
     render: (width: 8, height: 8, max_bounces: 10000),
@@ -135,38 +135,29 @@ fn dispersive_glass_detects_a_one_percent_bias() {
     }
 }
 
-/// A real bug found by the test above (issue 33), recorded: `bdpt` in the
-/// white furnace of a closed, two-sided emitting Lambertian *sphere* (ρ 0.5,
-/// camera inside; `tests/furnace.rs`'s scene) gives 1.770 ± 0.003 instead of
-/// L_e / (1 − ρ) = 2 (−11.5%; 16 seeds of 8x8 at 32 spp), while `path`
-/// (1.995 ± 0.003) and `lighttrace` (2.008 ± 0.016) agree with 2 and `bdpt`
-/// in the same furnace built as a cube is right (2.001 ± 0.005). At
-/// `max_bounces: 1` the answer is 1 + ρ = 1.5: path 1.5006 ± 0.0005,
-/// lighttrace 1.510 ± 0.008, bdpt 1.3718 ± 0.0006 (the one-bounce term 0.372
-/// instead of 0.5); at ρ 0 bdpt is right (1.00008 ± 0.00004). So a strategy's
-/// weight or density is wrong where the light is a sphere seen from inside
-/// that also scatters (its MIS weights do not sum to 1). Ignored until fixed
-/// (src/integrator/bdpt is not this change's to edit); run with
-/// `cargo test --test main bdpt_sphere_furnace -- --ignored`.
+/// A bug this test found (issue 33), fixed: `bdpt` in the white furnace of
+/// a closed, two-sided emitting Lambertian *sphere* (ρ 0.5, camera inside;
+/// `tests/furnace.rs`'s scene) gave 1.770 ± 0.003 instead of L_e / (1 − ρ) =
+/// 2 (−11.5%), while `path` and `lighttrace` agreed with 2. The shading
+/// points lie on the emitting sphere, which `SphereLight::sample_li` took for
+/// outside by rounding: the cone it sampled was a hemisphere whose point was
+/// the shading point itself, at distance 0. Points on the sphere within
+/// rounding now sample it by area (`src/light/sphere.rs`, `by_area`): 2.0005 ±
+/// 0.0012.
 #[test]
-#[ignore = "bdpt is 11.5% dark in a two-sided emitting Lambertian sphere furnace (a bug, see the doc)"]
-fn bdpt_sphere_furnace_is_biased() {
+fn bdpt_sphere_furnace_gives_two() {
     check("white furnace ρ 0.5 (sphere)", "bdpt", over_seeds(FURNACE, "bdpt", 256), 2.0);
 }
 
-/// A second bug found beside the first, recorded: a closed *one-sided*
+/// A second bug found beside the first, fixed with it: a closed *one-sided*
 /// emitting sphere (`two_sided: false`: it emits outward only) seen from
-/// inside must give exactly 0 (no light inside, and the cube built the same
-/// way gives exactly 0 with every method), but light sampled on the sphere
-/// leaks in: 16 seeds of 8x8 at 32 spp, ρ 0.5, give `whitted` 0.2587 ±
-/// 0.0016, `path` 0.1040 ± 0.0006 at `max_bounces: 1` and 0.2038 ± 0.0008
-/// with all bounces, `bdpt` 0.00075 ± 0.00001, `lighttrace` exactly 0 (it
-/// starts on the emitting side). Next-event estimation on a sphere light
-/// from a point inside it appears to ignore which side emits; it may share
-/// a cause with [`bdpt_sphere_furnace_is_biased`] (the sphere's density
-/// seen from inside). Ignored until fixed; run with `-- --ignored`.
+/// inside must give exactly 0 (the cube built the same way does with every
+/// method), but light sampling leaked its emission in: `whitted` 0.2587 ±
+/// 0.0016, `path` 0.2038 ± 0.0008, `bdpt` 0.00075 ± 0.00001 (16 seeds of 8x8
+/// at 32 spp, ρ 0.5). Same cause (a point on the sphere taken for outside);
+/// and by area a one-sided sphere now gives nothing from a point its outside
+/// does not face. Exactly 0 with every method.
 #[test]
-#[ignore = "a one-sided sphere emitter leaks light inside through light sampling (a bug, see the doc)"]
 fn one_sided_sphere_emitter_is_dark_inside() {
     let scene = FURNACE.replace("two_sided: true", "two_sided: false");
     for m in ["whitted", "path", "bdpt", "lighttrace"] {
