@@ -261,12 +261,25 @@ fn sigint_ends_a_render_promptly_and_saves_it() {
         .spawn()
         .unwrap();
     let pid = child.id().to_string();
-    std::thread::sleep(Duration::from_millis(300));
+    // Once the render has started (its handlers installed and a first pass done, as
+    // the checkpoint tests wait), not after a fixed sleep: a loaded machine may take
+    // longer than any sleep to load the scene.
+    let rendering = || {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+        let mask = status.lines().find_map(|l| l.strip_prefix("SigCgt:")).map(str::trim);
+        mask.and_then(|m| u64::from_str_radix(m, 16).ok()).is_some_and(|m| m & (1 << 1) != 0)
+    };
+    if std::path::Path::new("/proc").exists() {
+        assert!(wait_for(Duration::from_secs(30), rendering), "the handlers were never installed");
+    }
+    std::thread::sleep(Duration::from_millis(100));
     let t = Instant::now();
     Command::new("kill").args(["-INT", &pid]).status().unwrap();
     let o = child.wait_with_output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(t.elapsed() < Duration::from_secs(5), "took {:?} to stop", t.elapsed());
+    // Not a speed bound: the render's budget is 60 s, so finishing well before it
+    // shows the signal ended it (a tile's work is milliseconds).
+    assert!(t.elapsed() < Duration::from_secs(40), "took {:?} to stop: the signal was ignored", t.elapsed());
     assert!(wait_for(Duration::from_secs(1), || ckpt.exists()), "no checkpoint after SIGINT");
     // The message names both files it wrote (issue 34 item 15: it named only the snapshot).
     let err = stderr(&o);
@@ -329,8 +342,8 @@ fn a_signal_while_loading_exits_130_or_143_and_writes_nothing() {
         let t = Instant::now();
         Command::new("kill").args([signal, &pid]).status().unwrap();
         let o = child.wait_with_output().unwrap();
-        assert_eq!(o.status.code(), Some(status), "{signal}: {}", stderr(&o));
-        assert!(t.elapsed() < Duration::from_millis(1500), "{signal}: took {:?} (loading finished?)", t.elapsed());
+        // (Had loading finished first, the render would have stopped and saved: exit 0.)
+        assert_eq!(o.status.code(), Some(status), "{signal} after {:?}: {}", t.elapsed(), stderr(&o));
         assert!(stderr(&o).is_empty(), "{signal}: {}", stderr(&o));
         let mut files: Vec<String> =
             std::fs::read_dir(&d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
@@ -698,12 +711,13 @@ fn rough_glass_inside_the_same_glass_is_invisible() {
 // 12. Spectrum files: linear parsing, short excerpts, rows named (issue 34 items 4, 5).
 
 /// A `File(...)` spectrum whose second line holds 400 000 fields is refused
-/// quickly (before: 6.7 s, as each field's column was counted from the
-/// line's start) with one short error line (before: the whole 800 KB line
-/// was quoted). 3 s is generous for a linear scan of 800 KB plus a render
-/// start; the error quotes at most 60 characters of the line.
+/// with one short error line (before: the whole 800 KB line was quoted); the
+/// error quotes at most 60 characters of the line. The parse is linear in the
+/// line's length (before: 6.7 s, as each field's column was counted from the
+/// line's start; after: 9 ms, measured, printed here, not asserted: tests
+/// assert no wall-clock limits).
 #[test]
-fn a_spectrum_line_of_400k_fields_is_refused_fast_and_briefly() {
+fn a_spectrum_line_of_400k_fields_is_refused_briefly() {
     let d = temp_dir("hostile-wide-csv");
     let wide = vec!["1"; 400_000].join(",");
     std::fs::write(d.join("refl.csv"), format!("400,0.5\n{wide}\n")).unwrap();
@@ -715,7 +729,6 @@ fn a_spectrum_line_of_400k_fields_is_refused_fast_and_briefly() {
     eprintln!("400k fields: {took:?}, error of {} bytes", e.len());
     assert!(e.contains("refl.csv:2:") && e.contains("400000 fields"), "{e}");
     assert!(e.len() < 400, "the error quotes too much: {} bytes", e.len());
-    assert!(took < Duration::from_secs(3), "took {took:?}");
 }
 
 /// Out-of-range values in a spectrum file name the data file, its line and

@@ -139,13 +139,13 @@ mod tests {
         assert_eq!(parse_spectrum_file("a,b\nc,d\n").unwrap_err().line, 2);
     }
 
-    /// A line of a million fields is refused in time linear in its length
-    /// (before, each field's column was counted from the line's start: 6.7 s
-    /// for 400 000 fields, about 40 s for a million); 1 s is some 20 times
-    /// what the linear scan takes in a release-mode test. The error quotes at
-    /// most [`EXCERPT_CHARS`] characters of the line, and of a huge field.
+    /// A line of a million fields is refused (the parse is linear in its
+    /// length: before, each field's column was counted from the line's start,
+    /// 6.7 s for 400 000 fields; the time is printed, not asserted). The error
+    /// quotes at most [`EXCERPT_CHARS`] characters of the line, and of a huge
+    /// field.
     #[test]
-    fn a_million_fields_are_refused_fast_with_a_short_excerpt() {
+    fn a_million_fields_are_refused_with_a_short_excerpt() {
         let wide = vec!["1"; 1_000_000].join(",");
         let text = format!("nm,v\n400,0.5\n{wide}\n");
         let t = std::time::Instant::now();
@@ -154,7 +154,7 @@ mod tests {
         assert_eq!(e.line, 3);
         assert!(e.message.contains("1000000 fields") && e.message.contains("..."), "{}", e.message);
         assert!(e.message.len() < 60 + 100, "{} bytes", e.message.len());
-        assert!(took < std::time::Duration::from_secs(1), "took {took:?}");
+        eprintln!("a million fields: {took:?} (not asserted: no wall-clock limits in tests)");
         // One huge field: quoted up to 60 characters.
         let e = parse_spectrum_file(&format!("400,{}\n", "x".repeat(200_000))).unwrap_err();
         assert_eq!((e.line, e.col), (1, 5));
