@@ -18,7 +18,7 @@ use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, paren
 use rust_v::scene::{Scene, load_scene};
 
 use super::args::{MergeArgs, RenderArgs, ResumeArgs};
-use super::console::{count, say, warn};
+use super::console::{count, say, thread_pool, warn};
 use super::session::{Session, SessionPlan};
 
 fn default_output(scene: &Path) -> PathBuf {
@@ -37,7 +37,8 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", show_path(&output))));
     }
     let load_start = Instant::now();
-    let scene = load_scene(&args.scene, &args.settings.overrides())?;
+    // Loading (meshes are read and built in parallel) uses the threads asked for too.
+    let scene = thread_pool(args.run.threads)?.install(|| load_scene(&args.scene, &args.settings.overrides()))?;
     let load_time = load_start.elapsed();
     let s = &scene.settings;
     if args.spectral
@@ -122,7 +123,8 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     check_output_extension(&output)?;
     check_color_space(&output, args.color_space)?;
     ckpt.film.set_color_space(args.color_space);
-    let scene = load_scene(&ckpt.scene_path, &ckpt.settings.patch())
+    let scene = thread_pool(args.run.threads)?
+        .install(|| load_scene(&ckpt.scene_path, &ckpt.settings.patch()))
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?;
     if scene.content_hash != ckpt.content_hash {
         let changed = match &ckpt.inputs {

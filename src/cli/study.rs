@@ -169,7 +169,7 @@ pub fn converge_command(args: ConvergeArgs) -> Result<()> {
     let mut overrides = args.settings.overrides();
     overrides.width = overrides.width.or(Some(reference.width));
     overrides.height = overrides.height.or(Some(reference.height));
-    let mut scene = load_scene(&args.scene, &overrides)?;
+    let mut scene = thread_pool(args.run.threads)?.install(|| load_scene(&args.scene, &overrides))?;
     let (w, h) = (scene.settings.width, scene.settings.height);
     if (w, h) != (reference.width, reference.height) {
         return Err(Error::Settings(format!(
