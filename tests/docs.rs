@@ -410,3 +410,64 @@ fn readme_is_short_and_shows_the_two_commands() {
         "README.md's scene example differs from docs/scene-format.md's first"
     );
 }
+
+/// Every `fn` defined in the crate's Rust files (src/, tests/), by name.
+fn defined_fns() -> BTreeSet<String> {
+    fn walk(dir: &Path, out: &mut BTreeSet<String>) {
+        for e in std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()) {
+            if e.is_dir() {
+                walk(&e, out);
+            } else if e.extension().is_some_and(|x| x == "rs") {
+                for line in read(&e).lines() {
+                    let t = line.trim_start();
+                    let t = t.strip_prefix("pub ").or_else(|| t.strip_prefix("pub(crate) ")).unwrap_or(t);
+                    if let Some(rest) = t.strip_prefix("fn ") {
+                        let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                        out.insert(name);
+                    }
+                }
+            }
+        }
+    }
+    let mut out = BTreeSet::new();
+    walk(&root().join("src"), &mut out);
+    walk(&root().join("tests"), &mut out);
+    out
+}
+
+/// The failure matrix names the tests that back its cells (issue 33): every
+/// name in the last column of its table (`file.rs::name`, or a bare test
+/// name) and every `file.rs::name` anywhere in `tests/README.md` must be a
+/// function that exists. A renamed or deleted test fails this, not silently
+/// the matrix.
+#[test]
+fn every_test_the_failure_matrix_names_exists() {
+    let md = read(&root().join("tests/README.md"));
+    let fns = defined_fns();
+    let is_name =
+        |s: &str| !s.is_empty() && s.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+    let mut missing = Vec::new();
+    let mut seen = 0;
+    for (n, line) in md.lines().enumerate() {
+        let cells: Vec<&str> = line.split('|').collect();
+        // A matrix row: its last cell (before the closing `|`) names the tests.
+        let last = if line.starts_with("| ") && cells.len() >= 10 { cells[cells.len() - 2] } else { "" };
+        for quoted in line.split('`').skip(1).step_by(2) {
+            let name = match quoted.rsplit_once("::") {
+                Some((file, name)) if file.ends_with(".rs") => name,
+                Some(_) => continue,
+                None if last.contains(&format!("`{quoted}`")) && quoted.contains('_') => quoted,
+                None => continue,
+            };
+            if !is_name(name) {
+                continue;
+            }
+            seen += 1;
+            if !fns.contains(name) {
+                missing.push(format!("tests/README.md:{}: {quoted}", n + 1));
+            }
+        }
+    }
+    assert!(seen > 40, "found only {seen} test names: is the table's format still understood?");
+    assert!(missing.is_empty(), "tests named in the matrix that do not exist:\n{}", missing.join("\n"));
+}
