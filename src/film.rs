@@ -41,7 +41,7 @@
 use std::ops::Range;
 use std::path::Path;
 
-use crate::color::{ColorSpace, N_BINS, Spectrum, Xyz, bin_lambda_nm, xyz_to_linear_srgb_f64};
+use crate::color::{ColorSpace, N_BINS, Spectrum, Tonemap, Xyz, bin_lambda_nm, xyz_to_linear_srgb_f64};
 use crate::error::{Error, Result};
 use crate::io::image::{is_exr, write_exr, write_exr_in, write_linear_srgb};
 
@@ -169,6 +169,10 @@ pub struct Film {
     passes: u32,
     /// The colour space of EXR output (an output choice: not stored in checkpoints).
     color_space: ColorSpace,
+    /// The exposure of every output, in stops (`--exposure`; not stored either).
+    exposure_ev: f64,
+    /// How a PNG maps radiance to [0, 1] (`--tonemap`; not stored either).
+    tonemap: Tonemap,
     /// Row-major per-bin radiance sums (fixed point like `sums`), when the film is spectral
     /// (`--spectral`): 36 more sums per pixel, whose colour integral is `sums`.
     spectral: Option<Vec<[i128; N_BINS]>>,
@@ -215,6 +219,8 @@ impl Film {
             first_pass: 0,
             passes: 0,
             color_space: ColorSpace::Srgb,
+            exposure_ev: 0.0,
+            tonemap: Tonemap::Clip,
             spectral: None,
         }
     }
@@ -295,6 +301,8 @@ impl Film {
             first_pass: passes.start,
             passes: n,
             color_space: ColorSpace::Srgb,
+            exposure_ev: 0.0,
+            tonemap: Tonemap::Clip,
             spectral: None,
         })
     }
@@ -307,6 +315,13 @@ impl Film {
     /// The colour space of EXR output.
     pub fn color_space(&self) -> ColorSpace {
         self.color_space
+    }
+
+    /// Sets the exposure (stops: every output is scaled by `2^ev`, exactly) and
+    /// the tone mapping of PNG output ([`Tonemap`]; EXR stays linear).
+    pub fn set_picture(&mut self, exposure_ev: f64, tonemap: Tonemap) {
+        self.exposure_ev = exposure_ev;
+        self.tonemap = tonemap;
     }
 
     /// Width in pixels.
@@ -492,18 +507,29 @@ impl Film {
     /// Writes the image: linear EXR if `path` ends in `.exr` (in the film's colour space), else
     /// 16-bit sRGB PNG ([`crate::io::image::write_linear_srgb`]), atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
+        // 2^ev is exact, and at 0 stops nothing is multiplied: images bit-identical.
+        let scale = self.exposure_ev.exp2();
+        let expose = |v: f64| if self.exposure_ev == 0.0 { v } else { v * scale };
         if is_exr(path) && (self.color_space != ColorSpace::Srgb || self.spectral.is_some()) {
-            let pixels: Vec<[f64; 3]> = self.mean_xyz().into_iter().map(|p| self.color_space.from_xyz(p)).collect();
+            let pixels: Vec<[f64; 3]> =
+                self.mean_xyz().into_iter().map(|p| self.color_space.from_xyz(p).map(expose)).collect();
             let Some(spectral) = &self.spectral else {
                 return write_exr_in(path, self.width, self.height, &pixels, self.color_space);
             };
             let inv = if self.passes == 0 { 0.0 } else { 1.0 / self.passes as f64 };
             let bins: Vec<Vec<f32>> =
-                (0..N_BINS).map(|b| spectral.iter().map(|s| (from_fixed(s[b]) * inv) as f32).collect()).collect();
+                (0..N_BINS).map(|b| spectral.iter().map(|s| expose(from_fixed(s[b]) * inv) as f32).collect()).collect();
             let wavelengths: Vec<f32> = (0..N_BINS).map(bin_lambda_nm).collect();
             return write_exr(path, self.width, self.height, &pixels, self.color_space, Some((&wavelengths, &bins)));
         }
-        write_linear_srgb(path, self.width, self.height, &self.linear_srgb())
+        let mut rgb = self.linear_srgb();
+        if self.exposure_ev != 0.0 {
+            rgb.iter_mut().for_each(|p| *p = p.map(expose));
+        }
+        if !is_exr(path) && self.tonemap != Tonemap::Clip {
+            rgb.iter_mut().for_each(|p| *p = self.tonemap.apply(*p));
+        }
+        write_linear_srgb(path, self.width, self.height, &rgb)
     }
 }
 

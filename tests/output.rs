@@ -195,3 +195,42 @@ fn spectral_halves_merge_to_the_whole_render() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(std::fs::read(&merged).unwrap(), std::fs::read(&whole).unwrap());
 }
+
+/// `--exposure 1` doubles every linear value exactly (a power of two), in EXR
+/// output and in spectral channels' colour alike; `--exposure 0` is the image
+/// without the flag, bit for bit; `--tonemap filmic` changes a PNG (the
+/// Cornell box's light is brighter than 1, so clipping and the filmic curve
+/// differ there) and keeps it the same size; `--tonemap` with an EXR output is
+/// an error (EXR stays linear).
+#[test]
+fn exposure_doubles_exactly_and_tone_mapping_is_for_png() {
+    let d = temp_dir("picture");
+    let (plain, plus, zero) = (d.join("a.exr"), d.join("b.exr"), d.join("c.exr"));
+    for (out, extra) in [(&plain, &[][..]), (&plus, &["--exposure", "1"][..]), (&zero, &["--exposure", "0"][..])] {
+        let o = render(out, extra);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let linear = |p: &Path| match read_image(p).unwrap().2 {
+        Pixels::Linear(v) => v,
+        Pixels::Code16(_) => panic!("an EXR reads as floats"),
+    };
+    let (a, b) = (linear(&plain), linear(&plus));
+    assert!(a.iter().any(|p| p.iter().any(|&v| v > 0.0)));
+    for (p, q) in a.iter().zip(&b) {
+        assert_eq!(p.map(|v| v * 2.0), *q);
+    }
+    assert_eq!(std::fs::read(&plain).unwrap(), std::fs::read(&zero).unwrap());
+    let (clip, filmic) = (d.join("clip.png"), d.join("filmic.png"));
+    assert!(render(&clip, &[]).status.success());
+    assert!(render(&filmic, &["--tonemap", "filmic"]).status.success());
+    let (Pixels::Code16(c), Pixels::Code16(f)) = (read_image(&clip).unwrap().2, read_image(&filmic).unwrap().2) else {
+        panic!("PNGs read as codes")
+    };
+    assert_eq!(c.len(), f.len());
+    assert_ne!(c, f);
+    let o = render(&d.join("x.exr"), &["--tonemap", "filmic"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("--tonemap filmic is for PNG output"), "{err}");
+    let o = render(&d.join("y.png"), &["--exposure", "nan"]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{ArgMatches, Args, FromArgMatches, Parser, Subcommand};
 
-use rust_v::color::ColorSpace;
+use rust_v::color::{ColorSpace, Tonemap};
 use rust_v::error::Error;
 use rust_v::settings::{FIELDS, SettingsPatch};
 
@@ -105,6 +105,8 @@ pub struct RenderArgs {
     /// from D65) or xyz. PNG output is always sRGB.
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
+    #[command(flatten)]
+    pub picture: PictureArgs,
     /// With an .exr output: also write the 36 spectral bins (380-730 nm) as channels in the
     /// layout of Fichet et al. 2021, summed exactly like the colour (the checkpoint then holds
     /// them too, so resumed and merged renders stay bit-identical).
@@ -154,6 +156,8 @@ pub struct ResumeArgs {
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
     #[command(flatten)]
+    pub picture: PictureArgs,
+    #[command(flatten)]
     pub run: RunArgs,
     #[command(flatten)]
     pub checkpoint: CheckpointArgs,
@@ -176,9 +180,37 @@ pub struct MergeArgs {
     /// from D65) or xyz. PNG output is always sRGB.
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
+    #[command(flatten)]
+    pub picture: PictureArgs,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// How the image becomes a picture: exposure and tone mapping (output choices,
+/// like the colour space: not stored in checkpoints, so give them again on
+/// `resume` and `merge`).
+#[derive(Debug, Args, Clone, Copy, Default)]
+pub struct PictureArgs {
+    /// Exposure in stops: every output value is scaled by 2^EV (PNG and EXR; -64 to 64).
+    #[arg(long, value_name = "EV", default_value_t = 0.0, value_parser = parse_exposure, allow_negative_numbers = true)]
+    pub exposure: f64,
+    /// How a PNG maps radiance to [0, 1]: clip (each channel clipped, the default: earlier
+    /// images unchanged) or filmic (a filmic luminance curve, then out-of-gamut colours move
+    /// toward grey at constant luminance). EXR output stays linear.
+    #[arg(long, value_name = "OPERATOR", default_value = "clip", value_parser = parse_tonemap)]
+    pub tonemap: Tonemap,
+}
+
+fn parse_exposure(s: &str) -> std::result::Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && (-64.0..=64.0).contains(&v) => Ok(v),
+        _ => Err(format!("expected stops from -64 to 64, found {s:?}")),
+    }
+}
+
+fn parse_tonemap(s: &str) -> std::result::Result<Tonemap, String> {
+    Tonemap::from_name(s).ok_or_else(|| format!("expected one of {}, found {s:?}", Tonemap::NAMES.join(", ")))
 }
 
 /// A colour space by name.

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
-use rust_v::color::ColorSpace;
+use rust_v::color::{ColorSpace, Tonemap};
 use rust_v::error::{Error, Result, show_path};
 use rust_v::film::{Film, MAX_SAMPLE};
 use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, parent_dir};
@@ -33,6 +33,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
     check_output_extension(&output)?;
     check_color_space(&output, args.color_space)?;
+    check_tonemap(&output, args.picture.tonemap)?;
     if args.spectral && !rust_v::io::image::is_exr(&output) {
         return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", show_path(&output))));
     }
@@ -95,6 +96,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         inputs: Some(scene.input_hashes.clone()),
     };
     checkpoint.film.set_color_space(args.color_space);
+    checkpoint.film.set_picture(args.picture.exposure, args.picture.tonemap);
     let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, args.time);
     session.run(&scene, checkpoint, passes.end, &plan)
 }
@@ -122,7 +124,9 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     let output = args.output.clone().unwrap_or_else(|| ckpt.output.clone());
     check_output_extension(&output)?;
     check_color_space(&output, args.color_space)?;
+    check_tonemap(&output, args.picture.tonemap)?;
     ckpt.film.set_color_space(args.color_space);
+    ckpt.film.set_picture(args.picture.exposure, args.picture.tonemap);
     let scene = thread_pool(args.run.threads)?
         .install(|| load_scene(&ckpt.scene_path, &ckpt.settings.patch()))
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?;
@@ -242,7 +246,9 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     let mut merged = merge(parts)?;
     if !is_ckpt {
         check_color_space(&args.output, args.color_space)?;
+        check_tonemap(&args.output, args.picture.tonemap)?;
         merged.film.set_color_space(args.color_space);
+        merged.film.set_picture(args.picture.exposure, args.picture.tonemap);
     }
     if is_ckpt {
         merged.write(&args.output)?;
@@ -263,6 +269,18 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
 }
 
 /// A colour space other than sRGB needs an EXR output.
+/// Tone mapping is for PNG output: an EXR stays linear and unclipped.
+fn check_tonemap(output: &Path, tonemap: Tonemap) -> Result<()> {
+    if tonemap != Tonemap::Clip && rust_v::io::image::is_exr(output) {
+        return Err(Error::Settings(format!(
+            "--tonemap {} is for PNG output; {} is an EXR, which stays linear (--exposure applies to both)",
+            Tonemap::NAMES[tonemap as usize],
+            show_path(output)
+        )));
+    }
+    Ok(())
+}
+
 fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
     if space != ColorSpace::Srgb && !rust_v::io::image::is_exr(output) {
         return Err(Error::Settings(format!(

@@ -13,6 +13,7 @@ mod named;
 mod rgb;
 mod space;
 mod spectrum;
+mod tonemap;
 mod uplift;
 
 pub use cie::{CMF, INTEGRAL_RANGE_NM, bin_xyz, cmf_at, color_weights, color_weights_f64, tent, tent_weights};
@@ -22,4 +23,5 @@ pub use rgb::{
 };
 pub use space::ColorSpace;
 pub use spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Sampled, Spectrum, bin_lambda_nm};
+pub use tonemap::Tonemap;
 pub use uplift::{reflectance_to_linear_srgb, rgb_emission, rgb_reflectance};
