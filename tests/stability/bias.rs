@@ -16,7 +16,7 @@
 
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
-use super::{ENCLOSURE, method};
+use super::method;
 use crate::common::render_str;
 
 /// Independent seeds per estimate.
@@ -119,17 +119,7 @@ fn white_furnace_detects_a_one_percent_bias_in_every_method() {
 /// `glass.rs`).
 #[test]
 fn dispersive_glass_detects_a_one_percent_bias() {
-    let scene = format!(
-        r#"(
-        camera: (eye: (0, 0, 0), look_at: (0.3, 0.2, -1), fov_deg: 60),
-        render: (width: 8, height: 8, max_bounces: 64),
-        materials: {{ "glass": Dielectric(ior: Named("N-BK7")) }},
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"), {ENCLOSURE} ],
-    )"#
-    );
-    let ior = rust_v::bxdf::named_glass("N-BK7").unwrap();
-    let cmf = rust_v::color::color_weights();
-    let want: f64 = (0..36).map(|b| (ior.at(rust_v::color::bin_lambda_nm(b)) as f64).powi(2) * cmf[b][1] as f64).sum();
+    let (scene, want) = super::camera_inside_nbk7();
     for (m, spp) in [("hero", 64), ("random", 64), ("auto", 64), ("bdpt", 64)] {
         check("camera in N-BK7", m, over_seeds(&scene, m, spp), want);
     }

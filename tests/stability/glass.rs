@@ -42,18 +42,8 @@ fn camera_inside_glass_sees_n_squared_l() {
 /// `lighttrace`: exactly 0 in every pixel (seen through glass).
 #[test]
 fn camera_inside_dispersive_glass_sees_n_lambda_squared() {
-    let scene = format!(
-        r#"(
-        camera: (eye: (0, 0, 0), look_at: (0.3, 0.2, -1), fov_deg: 60),
-        render: (width: 8, height: 8, max_bounces: 64),
-        materials: {{ "glass": Dielectric(ior: Named("N-BK7")) }},
-        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"), {ENCLOSURE} ],
-    )"#
-    );
+    let (scene, spectral) = camera_inside_nbk7();
     let ior = rust_v::bxdf::named_glass("N-BK7").unwrap();
-    let cmf = rust_v::color::color_weights();
-    let spectral: f64 =
-        (0..36).map(|b| (ior.at(rust_v::color::bin_lambda_nm(b)) as f64).powi(2) * cmf[b][1] as f64).sum();
     let reference = (ior.at(589.3) as f64).powi(2);
     for m in METHODS {
         let film = render_str(&scene, &method(m, 32, 4));

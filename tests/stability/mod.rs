@@ -192,6 +192,24 @@ fn lighttrace_sees_only_the_enclosure(film: &Film, cover: &[Option<bool>], what:
 }
 
 /// A uniformly emitting enclosure (radiance 1, equal energy: Y = 1).
+/// The camera at the centre of a smooth N-BK7 sphere in the uniform
+/// enclosure, and the Y it must see: Σ_b n(λ_b)² ȳ_b (radiance n²L per
+/// wavelength inside a lossless dielectric).
+fn camera_inside_nbk7() -> (String, f64) {
+    let scene = format!(
+        r#"(
+        camera: (eye: (0, 0, 0), look_at: (0.3, 0.2, -1), fov_deg: 60),
+        render: (width: 8, height: 8, max_bounces: 64),
+        materials: {{ "glass": Dielectric(ior: Named("N-BK7")) }},
+        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"), {ENCLOSURE} ],
+    )"#
+    );
+    let ior = rust_v::bxdf::named_glass("N-BK7").unwrap();
+    let cmf = rust_v::color::color_weights();
+    let y = (0..36).map(|b| (ior.at(rust_v::color::bin_lambda_nm(b)) as f64).powi(2) * cmf[b][1] as f64).sum();
+    (scene, y)
+}
+
 const ENCLOSURE: &str = "(shape: Sphere(center: (0, 0, 0), radius: 10), emission: Constant(1), two_sided: true)";
 
 // ---------------------------------------------------------------------------
