@@ -274,7 +274,7 @@ fn check_tonemap(output: &Path, tonemap: Tonemap) -> Result<()> {
     if tonemap != Tonemap::Clip && rust_v::io::image::is_exr(output) {
         return Err(Error::Settings(format!(
             "--tonemap {} is for PNG output; {} is an EXR, which stays linear (--exposure applies to both)",
-            Tonemap::NAMES[tonemap as usize],
+            tonemap.name(),
             show_path(output)
         )));
     }

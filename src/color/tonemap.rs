@@ -48,6 +48,14 @@ impl Tonemap {
         }
     }
 
+    /// The operator's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::Clip => "clip",
+            Tonemap::Filmic => "filmic",
+        }
+    }
+
     /// Linear sRGB (any values) to linear sRGB in [0, 1]³. NaN becomes 0.
     pub fn apply(self, rgb: [f64; 3]) -> [f64; 3] {
         let rgb = rgb.map(|v| if v.is_nan() { 0.0 } else { v });
@@ -173,7 +181,7 @@ mod tests {
     #[test]
     fn names_round_trip() {
         for n in Tonemap::NAMES {
-            assert!(Tonemap::from_name(n).is_some());
+            assert_eq!(Tonemap::from_name(n).map(Tonemap::name), Some(n));
         }
         assert_eq!(Tonemap::from_name("aces"), None);
     }
