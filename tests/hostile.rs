@@ -250,6 +250,14 @@ fn fifos_devices_and_directories_are_refused_as_inputs() {
     }
 }
 
+/// Whether process `pid` has installed a handler for every signal in `mask`
+/// (bit `n - 1` for signal `n`), from `SigCgt` in `/proc/PID/status` (Linux).
+fn catches(pid: &str, mask: u64) -> bool {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+    let caught = status.lines().find_map(|l| l.strip_prefix("SigCgt:")).map(str::trim);
+    caught.and_then(|m| u64::from_str_radix(m, 16).ok()).is_some_and(|m| m & mask == mask)
+}
+
 #[test]
 fn sigint_ends_a_render_promptly_and_saves_it() {
     let d = temp_dir("hostile-sigint");
@@ -264,13 +272,8 @@ fn sigint_ends_a_render_promptly_and_saves_it() {
     // Once the render has started (its handlers installed and a first pass done, as
     // the checkpoint tests wait), not after a fixed sleep: a loaded machine may take
     // longer than any sleep to load the scene.
-    let rendering = || {
-        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
-        let mask = status.lines().find_map(|l| l.strip_prefix("SigCgt:")).map(str::trim);
-        mask.and_then(|m| u64::from_str_radix(m, 16).ok()).is_some_and(|m| m & (1 << 1) != 0)
-    };
     if std::path::Path::new("/proc").exists() {
-        assert!(wait_for(Duration::from_secs(30), rendering), "the handlers were never installed");
+        assert!(wait_for(Duration::from_secs(30), || catches(&pid, 1 << 1)), "the handlers were never installed");
     }
     std::thread::sleep(Duration::from_millis(100));
     let t = Instant::now();
@@ -333,12 +336,7 @@ fn a_signal_while_loading_exits_130_or_143_and_writes_nothing() {
             .spawn()
             .unwrap();
         let pid = child.id().to_string();
-        let caught = || {
-            let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
-            let mask_now = status.lines().find_map(|l| l.strip_prefix("SigCgt:")).map(str::trim);
-            mask_now.and_then(|m| u64::from_str_radix(m, 16).ok()).is_some_and(|m| m & mask != 0)
-        };
-        assert!(wait_for(Duration::from_secs(10), caught), "the handlers were never installed");
+        assert!(wait_for(Duration::from_secs(10), || catches(&pid, mask)), "the handlers were never installed");
         let t = Instant::now();
         Command::new("kill").args([signal, &pid]).status().unwrap();
         let o = child.wait_with_output().unwrap();

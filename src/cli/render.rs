@@ -358,6 +358,10 @@ fn check_files(
 /// dielectrics with the same surface, and a scene without any light (the
 /// image is black).
 fn warn_no_effect(scene: &Scene) {
+    // Two dielectric objects with the same surface: a ray meets one of the two surfaces
+    // at each crossing, so the medium stack cannot follow (measured: coincident glass and
+    // water spheres act as neither). Shapes compared exactly; meshes are not compared.
+    let mut seen = std::collections::HashMap::new();
     for (i, o) in scene.objects.iter().enumerate() {
         let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
         if o.priority != 0 && !dielectric {
@@ -366,13 +370,6 @@ fn warn_no_effect(scene: &Scene) {
                 o.priority
             ));
         }
-    }
-    // Two dielectric objects with the same surface: a ray meets one of the two surfaces
-    // at each crossing, so the medium stack cannot follow (measured: coincident glass and
-    // water spheres act as neither). Shapes compared exactly; meshes are not compared.
-    let mut seen = std::collections::HashMap::new();
-    for (i, o) in scene.objects.iter().enumerate() {
-        let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
         if !dielectric || matches!(o.shape, rust_v::shape::Shape::Mesh(_)) {
             continue;
         }
