@@ -10,6 +10,7 @@ mod bdpt;
 mod checkpoint;
 mod cli;
 mod docs;
+mod environment;
 mod furnace;
 mod fuzz;
 mod hostile;

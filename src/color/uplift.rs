@@ -187,12 +187,92 @@ pub fn fit_coefficients(rgb: [f64; 3]) -> [f64; 3] {
 /// The reflectance spectrum of linear sRGB `rgb` under D65 (components in [0, 1]; out-of-range
 /// values are clamped): exactly `r` everywhere for a grey, else the fitted sigmoid, in [0, 1].
 pub fn rgb_reflectance(rgb: [f32; 3]) -> Spectrum {
-    let [r, g, b] = rgb.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 });
-    if r == g && g == b {
-        return Spectrum::splat(r);
+    Uplift::reflectance(rgb, None).spectrum()
+}
+
+/// A colour uplifted but not yet evaluated: what a texel keeps (a grey, or the sigmoid's three
+/// coefficients: 24 bytes instead of a 144-byte spectrum). [`Uplift::spectrum`] gives exactly
+/// what [`rgb_reflectance`] gives for the same colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Uplift {
+    /// The constant spectrum of this value.
+    Grey(f32),
+    /// The sigmoid of a quadratic with these coefficients.
+    Sigmoid([f64; 3]),
+}
+
+impl Uplift {
+    /// The reflectance of linear sRGB `rgb` (clamped into [0, 1]). With `near`, the
+    /// coefficients of a similar colour (the previous texel of an image row), the fit starts
+    /// there and takes a few Levenberg-Marquardt steps; only if they leave a colour error
+    /// above 1e-6 does it fall back to the full fit from grey. Equal colours give equal
+    /// coefficients either way when the caller reuses them (see `crate::texture`).
+    pub fn reflectance(rgb: [f32; 3], near: Option<[f64; 3]>) -> Uplift {
+        let [r, g, b] = rgb.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 });
+        if r == g && g == b {
+            return Uplift::Grey(r);
+        }
+        let target = [r as f64, g as f64, b as f64];
+        if let Some(start) = near {
+            let c = refine(start, target, 12);
+            if colour_error2(c, target) < 1e-12 {
+                return Uplift::Sigmoid(c);
+            }
+        }
+        Uplift::Sigmoid(fit_coefficients(target))
     }
-    let rho = eval(fit_coefficients([r as f64, g as f64, b as f64]));
-    Spectrum::from_fn(|i| rho[i].clamp(0.0, 1.0) as f32)
+
+    /// The coefficients, for warm-starting the next fit (grey: the sigmoid's constant).
+    pub fn coefficients(&self) -> [f64; 3] {
+        match *self {
+            Uplift::Grey(v) => {
+                // S(x) = v  ⇔  x = (2v − 1) / (2 √(v (1 − v))), finite inside (0, 1).
+                let v = (v as f64).clamp(1e-6, 1.0 - 1e-6);
+                [0.0, 0.0, (2.0 * v - 1.0) / (2.0 * (v * (1.0 - v)).sqrt())]
+            }
+            Uplift::Sigmoid(c) => c,
+        }
+    }
+
+    /// The reflectance spectrum at the 36 bins, in [0, 1].
+    #[inline]
+    pub fn spectrum(&self) -> Spectrum {
+        match *self {
+            Uplift::Grey(v) => Spectrum::splat(v),
+            Uplift::Sigmoid(c) => {
+                let rho = eval(c);
+                Spectrum::from_fn(|i| rho[i].clamp(0.0, 1.0) as f32)
+            }
+        }
+    }
+}
+
+/// The squared colour error of coefficients `c` against `target`.
+fn colour_error2(c: [f64; 3], target: [f64; 3]) -> f64 {
+    let rgb = reflectance_to_linear_srgb(&eval(c));
+    (0..3).map(|i| (rgb[i] - target[i]).powi(2)).sum()
+}
+
+/// An emission colour as a texel keeps it: [`rgb_emission`] is `scale · uplift · D65` with
+/// these two (the scale folds in `1 / Y(D65)`); black is a zero scale.
+pub fn emission_uplift(rgb: [f32; 3], near: Option<[f64; 3]>) -> (Uplift, f32) {
+    let rgb = rgb.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m == 0.0 {
+        return (Uplift::Grey(0.0), 0.0);
+    }
+    let s = 2.0 * m;
+    (Uplift::reflectance(rgb.map(|v| v / s), near), s / d65().to_xyz().y)
+}
+
+/// The emission spectrum of a texel from [`emission_uplift`]: bit for bit what
+/// [`rgb_emission`] gives for the same colour.
+#[inline]
+pub fn emission_spectrum(uplift: &Uplift, scale: f32, d65: &Spectrum) -> Spectrum {
+    if scale == 0.0 {
+        return Spectrum::ZERO;
+    }
+    uplift.spectrum() * *d65 * scale
 }
 
 /// The emission spectrum of linear sRGB `rgb` (non-negative components; negative or non-finite
@@ -204,11 +284,8 @@ pub fn rgb_emission(rgb: [f32; 3]) -> Spectrum {
     if m == 0.0 {
         return Spectrum::ZERO;
     }
-    let s = 2.0 * m;
-    let rho = rgb_reflectance(rgb.map(|v| v / s));
-    let d = d65();
-    let y = d.to_xyz().y;
-    rho * d * (s / y)
+    let (uplift, scale) = emission_uplift(rgb, None);
+    emission_spectrum(&uplift, scale, &d65())
 }
 
 #[cfg(test)]

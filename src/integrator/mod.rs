@@ -369,7 +369,7 @@ pub(crate) fn sample_direct<const N: usize>(
     } else {
         power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, outside))
     };
-    f * lambdas.sample(scene.light(choice.light).spectrum()) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+    f * lambdas.sample(&scene.light(choice.light).radiance(ls.wi)) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
 }
 
 #[cfg(test)]

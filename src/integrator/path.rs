@@ -108,7 +108,13 @@ impl PathTracer {
         sampler: &mut Sampler,
     ) -> O {
         let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
-            return O::default();
+            // The camera sees the environment (or black).
+            return match scene.escaped(ray.dir) {
+                Some((_, le)) if scene.medium_in(scene.camera_volumes.current()).is_none() => {
+                    O::from_packet(lambdas, &lambdas.sample(&le))
+                }
+                _ => O::default(),
+            };
         };
         let walk = Walk {
             beta: Sampled::splat(1.0),
@@ -163,7 +169,11 @@ impl PathTracer {
                 ray = Ray::spawn(hit.p, hit.n, ray.dir);
                 match scene.intersect(&ray, f32::INFINITY) {
                     Some(next) if passes <= MAX_PASSES => si = next,
-                    _ => break,
+                    Some(_) => break,
+                    None => {
+                        l += escape(scene, &ray, &w, lambdas);
+                        break;
+                    }
                 }
                 continue;
             }
@@ -260,7 +270,10 @@ impl PathTracer {
             ray = Ray::spawn(hit.p, hit.n, wi);
             match scene.intersect(&ray, f32::INFINITY) {
                 Some(next) => si = next,
-                None => break,
+                None => {
+                    l += escape(scene, &ray, &w, lambdas);
+                    break;
+                }
             }
         }
         let mut out = O::from_packet(lambdas, &l);
@@ -358,6 +371,22 @@ impl PathTracer {
             *split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
         });
         None
+    }
+}
+
+/// The environment's radiance for a walk whose ray escaped the scene,
+/// MIS-weighted against the light sample taken at the previous vertex (zero
+/// without an environment, or when the path is inside an absorbing medium:
+/// an infinite segment there transmits nothing).
+#[inline]
+fn escape<const N: usize>(scene: &Scene, ray: &Ray, w: &Walk<N>, lambdas: &Lambdas<N>) -> Sampled<N> {
+    match scene.escaped(ray.dir) {
+        Some((light, le)) if scene.medium_in(w.media.current()).is_none() => {
+            let weight =
+                if w.prev.delta { 1.0 } else { power_heuristic(w.prev.pdf_bsdf, scene.pdf_escaped(light, ray.dir)) };
+            w.beta * lambdas.sample(&le) * weight
+        }
+        _ => Sampled::splat(0.0),
     }
 }
 

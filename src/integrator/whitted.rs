@@ -42,7 +42,16 @@ impl Whitted {
         let mut bounces = 0;
         let mut media = scene.camera_volumes;
         let mut passes = 0;
-        while let Some(si) = scene.intersect(&ray, f32::INFINITY) {
+        loop {
+            let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+                // Seen directly or through specular surfaces: the environment.
+                if let Some((_, le)) = scene.escaped(ray.dir)
+                    && scene.medium_in(media.current()).is_none()
+                {
+                    l += beta * lambdas.sample(&le);
+                }
+                break;
+            };
             let hit = &si.hit;
             // Beer-Lambert absorption along the segment, in the medium it ran in.
             if let Some(medium) = scene.medium_in(media.current()) {

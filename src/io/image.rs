@@ -119,10 +119,13 @@ pub enum Pixels {
 /// Reads a PNG (8 or 16 bits per channel) or an EXR (linear sRGB floats):
 /// width, height and pixels.
 pub fn read_image(path: &Path) -> Result<(u32, u32, Pixels)> {
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| Error::io(path, e))?
-        .with_guessed_format()
-        .map_err(|e| Error::io(path, e))?;
+    decode_image(path, &crate::io::read_input(path)?)
+}
+
+/// Decodes `bytes`, the content of the PNG or EXR file at `path` (named in errors), as
+/// [`read_image`] does.
+pub fn decode_image(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Pixels)> {
+    let reader = image::ImageReader::new(Cursor::new(bytes)).with_guessed_format().map_err(|e| Error::io(path, e))?;
     let bad = |message: String| Error::Image { path: path.to_path_buf(), message };
     let format = reader.format();
     let img = reader.decode().map_err(|e| bad(format!("cannot decode: {e}")))?;

@@ -74,7 +74,7 @@ impl Light {
         match self {
             Light::Point(_) => 1.0,
             Light::Spot(l) => l.falloff(w),
-            Light::Distant(_) | Light::Beam(_) => 0.0,
+            Light::Distant(_) | Light::Beam(_) | Light::Environment(_) => 0.0,
             Light::Sphere(_) | Light::Disk(_) | Light::Area(_) => self.le_scale(n, -w) * w.dot(n).abs(),
         }
     }
@@ -91,6 +91,7 @@ impl Light {
             Light::Area(l) => l.sample_le(u_pos, u_dir),
             Light::Distant(l) => l.sample_le(u_pos),
             Light::Beam(l) => l.sample_le(u_pos),
+            Light::Environment(l) => l.sample_le(u_pos, u_dir),
         }
     }
 
@@ -108,6 +109,7 @@ impl Light {
             Light::Area(l) => l.pdf_le(n, dir),
             Light::Distant(l) => l.pdf_le(),
             Light::Beam(l) => l.pdf_le(),
+            Light::Environment(l) => l.pdf_le(dir),
         }
     }
 }

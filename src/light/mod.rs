@@ -27,6 +27,7 @@ mod beam;
 mod disk;
 mod distant;
 mod emit;
+mod environment;
 mod point;
 mod sphere;
 mod spot;
@@ -36,6 +37,7 @@ pub use beam::BeamLight;
 pub use disk::DiskLight;
 pub use distant::DistantLight;
 pub use emit::EmissionSample;
+pub use environment::{EnvironmentLight, MAX_MAP_TEXELS};
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use spot::SpotLight;
@@ -65,6 +67,8 @@ pub enum Light {
     Distant(DistantLight),
     /// A collimated beam from a disk.
     Beam(BeamLight),
+    /// Radiance from every direction at infinity (the scene's `environment:`).
+    Environment(Box<EnvironmentLight>),
 }
 
 /// A direction towards a light from a shading point.
@@ -88,7 +92,9 @@ pub struct LightSample {
 
 impl Light {
     /// The spectrum emitted: radiance for area lights, intensity for point
-    /// and spot lights, irradiance for distant lights and beams.
+    /// and spot lights, irradiance for distant lights and beams; for the
+    /// environment, whose radiance varies with direction, the per-bin peak
+    /// (for warnings only: a sample's radiance is [`Light::radiance`]).
     #[inline]
     pub fn spectrum(&self) -> &Spectrum {
         match self {
@@ -99,7 +105,26 @@ impl Light {
             Light::Spot(l) => &l.intensity,
             Light::Distant(l) => &l.irradiance,
             Light::Beam(l) => &l.irradiance,
+            Light::Environment(l) => &l.peak,
         }
+    }
+
+    /// What arrives from the light along the sampled direction `wi` (from
+    /// the shading point towards the light), as [`Light::spectrum`] says
+    /// for each kind: the environment's radiance from `wi`, every other
+    /// light's one spectrum.
+    #[inline]
+    pub fn radiance(&self, wi: Vec3) -> std::borrow::Cow<'_, Spectrum> {
+        match self {
+            Light::Environment(l) => std::borrow::Cow::Owned(l.radiance(wi)),
+            _ => std::borrow::Cow::Borrowed(self.spectrum()),
+        }
+    }
+
+    /// True for the environment (a light at infinity, non-delta: escaped rays see it).
+    #[inline]
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Environment(_))
     }
 
     /// Total emitted power up to the spectrum's shape (mean over bins), used to
@@ -113,6 +138,7 @@ impl Light {
             Light::Spot(l) => l.power(),
             Light::Distant(l) => l.power(),
             Light::Beam(l) => l.power(),
+            Light::Environment(l) => l.power(),
         }
     }
 
@@ -127,6 +153,7 @@ impl Light {
             Light::Spot(l) => l.sample_li(p),
             Light::Distant(l) => l.sample_li(p),
             Light::Beam(l) => l.sample_li(p),
+            Light::Environment(l) => l.sample_li(p, u),
         }
     }
 
@@ -140,15 +167,23 @@ impl Light {
             Light::Sphere(l) => l.pdf_li(p, wi, point),
             Light::Disk(l) => l.pdf_li(p, wi, point),
             Light::Area(l) => l.pdf_li(p, wi, point, n),
+            Light::Environment(l) => l.pdf_li(wi),
         }
     }
 
     /// Tells lights that depend on the scene's size (distant lights) the
     /// centre and radius of a sphere around everything bounded and the camera.
     pub fn set_scene_bounds(&mut self, center: Vec3, radius: f32) {
-        if let Light::Distant(l) = self {
-            l.scene_radius = radius;
-            l.scene_center = center;
+        match self {
+            Light::Distant(l) => {
+                l.scene_radius = radius;
+                l.scene_center = center;
+            }
+            Light::Environment(l) => {
+                l.scene_radius = radius;
+                l.scene_center = center;
+            }
+            _ => {}
         }
     }
 
@@ -158,7 +193,9 @@ impl Light {
     #[inline]
     pub fn le_scale(&self, n: Vec3, dir: Vec3) -> f32 {
         let two_sided = match self {
-            Light::Point(_) | Light::Spot(_) | Light::Distant(_) | Light::Beam(_) => return 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Distant(_) | Light::Beam(_) | Light::Environment(_) => {
+                return 0.0;
+            }
             Light::Sphere(l) => l.two_sided,
             Light::Disk(l) => l.two_sided,
             Light::Area(l) => l.two_sided,

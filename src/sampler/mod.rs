@@ -55,6 +55,7 @@
 //! `sobol` sampler gives them hashed random numbers of `(seed, p, k, dim)`,
 //! deterministic like everything else.
 
+pub mod piecewise;
 pub mod sobol;
 pub mod warp;
 

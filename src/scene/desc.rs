@@ -48,6 +48,34 @@ pub struct SceneDesc {
     /// Lights that are not objects (point lights).
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// Radiance from infinitely far away, seen by every ray that escapes
+    /// (`crate::light::EnvironmentLight`); none by default (escaping rays see black).
+    #[serde(default)]
+    pub environment: Option<EnvironmentDesc>,
+}
+
+/// The scene's `environment:`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum EnvironmentDesc {
+    /// The same radiance from every direction: `Uniform(Constant(1))`.
+    Uniform(SpectrumDesc),
+    /// An equirectangular map (PNG, sRGB-decoded, or EXR, linear), +y up:
+    /// `Image(path: "sky.exr", scale: 1, rotate_deg: (0, 90, 0))`.
+    Image {
+        /// The image file, relative to the scene file.
+        path: String,
+        /// A factor on every texel (default 1).
+        #[serde(default = "one")]
+        scale: f32,
+        /// Turns the map about X, then Y, then Z, in degrees (default none).
+        #[serde(default)]
+        rotate_deg: V3,
+    },
+}
+
+fn one() -> f32 {
+    1.0
 }
 
 /// The `materials` map in file order; a name given twice is an error

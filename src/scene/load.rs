@@ -18,7 +18,7 @@ use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
 use crate::io::{Fnv1a, fnv1a, read_input};
-use crate::light::Light;
+use crate::light::{EnvironmentLight, Light};
 use crate::material;
 use crate::settings::{Settings, SettingsPatch};
 use crate::shape::{Mesh, MeshAhead, Placement, Shape};
@@ -216,6 +216,9 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     }
     for (i, l) in desc.lights.iter().enumerate() {
         lights.push(Light::from_desc(ctx, &format!("lights[{i}]"), l)?);
+    }
+    if let Some(e) = &desc.environment {
+        lights.push(Light::Environment(Box::new(EnvironmentLight::from_desc(ctx, e)?)));
     }
     if objects.is_empty() {
         return Err(ctx.err("objects", "expected at least one object"));

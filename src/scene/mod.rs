@@ -92,6 +92,10 @@ pub struct Scene {
     /// The bounded objects in lanes of four, for a small scene of quads and
     /// spheres (no BVH then).
     batch: Option<Batch>,
+    /// The index of the environment light in `lights`, if the scene has one.
+    environment: Option<u32>,
+    /// The radius of a sphere around everything bounded and the camera.
+    radius: f32,
     /// Whether any object's material is dispersive (computed once: the
     /// `spectral` integrator asks for every camera sample).
     dispersive: bool,
@@ -161,7 +165,10 @@ impl Scene {
             })
             .collect();
         let dispersive = objects.iter().any(|o| materials.get(o.material as usize).is_some_and(Bxdf::is_dispersive));
+        let environment = lights.iter().position(Light::is_infinite).map(|i| i as u32);
         Scene {
+            environment,
+            radius,
             dispersive,
             objects,
             materials,
@@ -182,6 +189,12 @@ impl Scene {
             inputs: Vec::new(),
             input_hashes: Default::default(),
         }
+    }
+
+    /// The radius of a sphere around everything bounded and the camera (at least 1).
+    #[inline]
+    pub fn radius(&self) -> f32 {
+        self.radius
     }
 
     /// The closest hit along `ray` before `t_max`.

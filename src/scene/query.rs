@@ -16,10 +16,11 @@
 //! | the volume a dielectric's surface bounds, and the medium inside | [`Scene::volume`], [`Scene::medium_in`] |
 //! | whether a segment between two points is clear, and its attenuation | [`Scene::transmittance`]: the one visibility rule |
 //!
-//! A ray that escapes the scene meets nothing today: no infinite light exists
-//! yet. The integrators' escape branches (`path.rs`, `whitted.rs`, and
-//! `bdpt/walk.rs`) are where an environment light will answer, through a
-//! query added here.
+//! | the radiance a ray that escapes the scene sees | [`Scene::escaped`], and its light-sampling density for MIS, [`Scene::pdf_escaped`] |
+//!
+//! A ray that escapes meets the environment (`crate::light::EnvironmentLight`)
+//! when the scene has one, else nothing: every integrator's escape branch
+//! asks [`Scene::escaped`].
 
 use glam::Vec3;
 
@@ -132,6 +133,33 @@ impl Scene {
         let light = &self.lights[index as usize];
         let scale = light.le_scale(si.hit.n, dir);
         (scale > 0.0).then_some(Emitted { light: index, radiance: light.spectrum(), scale })
+    }
+
+    /// The environment's light index and its radiance from direction `dir`,
+    /// for a ray that escaped the scene along `dir`; `None` without an environment.
+    #[inline]
+    pub fn escaped(&self, dir: Vec3) -> Option<(u32, Spectrum)> {
+        let index = self.environment?;
+        match &self.lights[index as usize] {
+            Light::Environment(env) => Some((index, env.radiance(dir))),
+            _ => None,
+        }
+    }
+
+    /// The density per unit solid angle with which [`Scene::sample_li`] would
+    /// have chosen the environment in direction `dir` (light choice included).
+    #[inline]
+    pub fn pdf_escaped(&self, light: u32, dir: Vec3) -> f32 {
+        match &self.lights[light as usize] {
+            Light::Environment(env) => self.light_pmf[light as usize] * env.pdf_li(dir),
+            _ => 0.0,
+        }
+    }
+
+    /// True when the scene has an environment.
+    #[inline]
+    pub fn has_environment(&self) -> bool {
+        self.environment.is_some()
     }
 
     /// The density per unit solid angle with which [`Scene::sample_li`] from

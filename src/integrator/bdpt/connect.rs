@@ -109,10 +109,14 @@ impl Bdpt {
     ) -> Contrib {
         const NONE: Contrib = Contrib::Full(Spectrum::ZERO);
         let pt = &camera.v[t - 1];
+        let ptm = &camera.v[t - 2];
+        if let Kind::Light(index) = pt.kind {
+            // The camera subpath escaped to the environment (its only light vertex).
+            return if s == 0 { self.escaped(scene, camera, t, index, wl) } else { NONE };
+        }
         let Kind::Surface(object) = pt.kind else {
             return NONE;
         };
-        let ptm = &camera.v[t - 2];
         match s {
             0 => {
                 // The camera subpath ends on an emitter.
@@ -151,6 +155,7 @@ impl Bdpt {
                     return NONE;
                 };
                 let light = scene.light(index);
+                let radiance = light.radiance(ls.wi);
                 let wi = pt.sh.frame.to_local(ls.wi);
                 if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
@@ -161,11 +166,9 @@ impl Bdpt {
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
                     let f = bxdf.eval_within(pt.sh.wo, wi, &one.lambdas, out)[0];
-                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(light.spectrum())[0] * k)
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(&radiance)[0] * k)
                 } else {
-                    Contrib::Full(
-                        pt.beta * bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out) * *light.spectrum() * k,
-                    )
+                    Contrib::Full(pt.beta * bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out) * *radiance * k)
                 };
                 if is_black(&c) {
                     return NONE;
@@ -174,9 +177,11 @@ impl Bdpt {
                 let Some(transmittance) = segment(scene, pt, media.as_ref(), ls.point, ls.n) else {
                     return NONE;
                 };
-                // The sampled light vertex, for the MIS weight.
-                let (pdf_pos, _) = light.pdf_le(ls.n, -ls.wi);
-                let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pmf * pdf_pos);
+                // The sampled light vertex, for the MIS weight (on the environment,
+                // a direction: its density is the direction's).
+                let (pdf_pos, pdf_dir) = light.pdf_le(ls.n, -ls.wi);
+                let pdf_y = if light.is_infinite() { pmf * pdf_dir } else { pmf * pdf_pos };
+                let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pdf_y);
                 let pt_rev = pdf_light(scene, &y, pt);
                 let ptm_rev = bxdf.pdf_within(wi, pt.sh.wo, &Lambdas::full(), out) * pt.g_prev;
                 let qs_rev = to_area(scene, bxdf.pdf_within(pt.sh.wo, wi, &Lambdas::full(), out), pt, &y);
@@ -234,6 +239,35 @@ impl Bdpt {
                 scale(c, weight, transmittance, wl)
             }
         }
+    }
+}
+
+impl Bdpt {
+    /// Strategy `(0, t)` for a camera subpath that escaped to the environment
+    /// (light `index`): its radiance, MIS-weighted. The densities a light
+    /// subpath would have made the ends with are the environment's direction
+    /// density at `x_{t-1}` and its disk's, projected, at `x_{t-2}`. A path
+    /// straight from the eye to the environment (`t = 2`) has no other
+    /// strategy (no light subpath connects to the eye from infinity): weight 1.
+    fn escaped(&self, scene: &Scene, camera: Sub<'_>, t: usize, index: u32, wl: &mut Wavelength) -> Contrib {
+        let (pt, ptm) = (&camera.v[t - 1], &camera.v[t - 2]);
+        let light = scene.light(index);
+        let dir = (pt.p() - ptm.p()).normalize();
+        let le = light.radiance(dir);
+        let c = if pt.collapsed {
+            let one = wl.single();
+            Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(&le)[0])
+        } else {
+            Contrib::Full(pt.beta * *le)
+        };
+        if t == 2 {
+            return c;
+        }
+        let (_, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
+        let pt_rev = scene.light_pmf(index) * pdf_dir;
+        let ptm_rev = pdf_light(scene, pt, ptm);
+        let overrides = Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 };
+        scale(c, mis_weight(scene, camera.v, t, &[], 0, overrides), None, wl)
     }
 }
 

@@ -189,6 +189,16 @@ impl Estimator for Bdpt {
             let (mut l, mut l_single) = (Spectrum::ZERO, 0.0f32);
             if !self.light_only {
                 self.camera_subpath(scene, film, sampler, camera, track.then_some(&mut *camera_media), &mut wl);
+            } else if scene.has_environment() {
+                // Light tracing cannot reach the eye from infinity: the environment
+                // seen directly is the pixel ray's, unweighted (the only strategy).
+                let ray = scene.camera.ray(film);
+                if scene.intersect(&ray, f32::INFINITY).is_none()
+                    && scene.medium_in(scene.camera_volumes.current()).is_none()
+                    && let Some((_, le)) = scene.escaped(ray.dir)
+                {
+                    l += le;
+                }
             }
             self.light_subpath(scene, sampler, light, track.then_some(&mut *light_media), &mut wl);
             let max = self.max_bounces as usize;
@@ -268,17 +278,22 @@ impl Bdpt {
         if !(pdf_origin > 0.0 && e.pdf_dir > 0.0) {
             return;
         }
-        let beta0 = *light.spectrum() / pdf_origin;
-        path.push(Vertex::at_point(Kind::Light(index as u32), e.point, e.n, beta0, pdf_origin));
+        let infinite = light.is_infinite();
+        let beta0 = *light.radiance(-e.dir) / pdf_origin;
+        // The environment's first vertex is a direction: its density is the
+        // direction's (per solid angle), as a camera subpath escaping along it sees it.
+        let pdf_y0 = if infinite { pmf * e.pdf_dir } else { pdf_origin };
+        path.push(Vertex::at_point(Kind::Light(index as u32), e.point, e.n, beta0, pdf_y0));
         let media = scene.volumes_at(e.point);
         if let Some(stacks) = stacks.as_deref_mut() {
             stacks.push(media);
         }
-        let cos = if light.is_delta() { 1.0 } else { e.dir.dot(e.n).abs() };
+        let cos = if light.is_delta() || infinite { 1.0 } else { e.dir.dot(e.n).abs() };
         let beta = beta0 * (e.scale * cos / e.pdf_dir);
-        // A parallel light's next vertex has the density of the ray's origin
-        // on the light's disk, projected (no 1/d²): passed as its "pdf".
-        let (pdf, parallel) = if light.is_delta_direction() { (e.pdf_pos, true) } else { (e.pdf_dir, false) };
+        // A parallel light's (or the environment's) next vertex has the density of the
+        // ray's origin on the light's disk, projected (no 1/d²): passed as its "pdf".
+        let (pdf, parallel) =
+            if light.is_delta_direction() || infinite { (e.pdf_pos, true) } else { (e.pdf_dir, false) };
         let ray = Ray::spawn(e.point, e.n, e.dir);
         let walk = Walk { importance: true, max_vertices: self.max_bounces as usize + 1 };
         walk.run(scene, ray, beta, pdf, parallel, sampler, path, stacks, media, wl);

@@ -63,6 +63,13 @@ impl Vertex {
         self.sh.p
     }
 
+    /// True for a vertex on the environment (at infinity: its `p` is a point
+    /// far beyond the scene in its direction, its densities per solid angle).
+    #[inline]
+    pub(super) fn is_infinite(&self, scene: &Scene) -> bool {
+        matches!(self.kind, Kind::Light(i) if scene.light(i).is_infinite())
+    }
+
     /// True when densities arriving at this vertex carry its cosine (area
     /// measure on a surface): surfaces and area lights, not the eye or a
     /// point, spot, distant or beam light.
@@ -173,6 +180,10 @@ pub(super) fn outside(scene: &Scene, material: Option<u32>) -> Outside<'_> {
 /// per unit area at `to`.
 #[inline]
 pub(super) fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -> f32 {
+    if to.is_infinite(scene) {
+        // A vertex on the environment is a direction: its density stays per solid angle.
+        return pdf_dir;
+    }
     let d = to.p() - from.p();
     let d2 = d.length_squared();
     if d2.is_nan() || d2 <= 0.0 {
@@ -205,7 +216,7 @@ pub(super) fn pdf_light(scene: &Scene, y: &Vertex, next: &Vertex) -> f32 {
     let light = scene.light(i);
     let w = (next.p() - y.p()).normalize_or_zero();
     let (pdf_pos, pdf_dir) = light.pdf_le(y.sh.n, w);
-    if light.is_delta_direction() {
+    if light.is_delta_direction() || light.is_infinite() {
         // Parallel rays: the disk's density projected onto `next`.
         let cos = if next.on_surface(scene) { w.dot(next.sh.n).abs() } else { 1.0 };
         return pdf_pos * cos;

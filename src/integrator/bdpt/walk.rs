@@ -48,6 +48,19 @@ impl Walk {
         let mut eta_scale = 1.0f32;
         while path.len() < self.max_vertices {
             let Some(si) = scene.intersect(&ray, f32::INFINITY) else {
+                // A camera subpath that escapes ends on the environment (outside any medium).
+                if let Some((index, _)) = scene.escaped(ray.dir)
+                    && !self.importance
+                    && scene.medium_in(media.current()).is_none()
+                {
+                    let far = ray.origin + ray.dir * (4.0 * scene.radius());
+                    let mut v = Vertex::at_point(Kind::Light(index), far, -ray.dir, beta, pdf_dir);
+                    v.collapsed = collapsed;
+                    path.push(v);
+                    if let Some(stacks) = stacks.as_deref_mut() {
+                        stacks.push(media);
+                    }
+                }
                 break;
             };
             let hit = si.hit;

@@ -1,0 +1,115 @@
+//! The environment light (`environment:`): furnaces against closed forms,
+//! a constant map against `Uniform(Rgb(...))`, and bad maps.
+//!
+//! A convex object under a uniform environment of radiance 1 sees only the
+//! environment: a Lambertian surface of reflectance ρ reflects ρ (∫ L cos/π dω
+//! over the hemisphere is 1), and every pixel that misses it sees 1.
+
+use rust_v::settings::SettingsPatch;
+
+use crate::common::{mean_and_stderr, render_str, temp_dir};
+
+fn furnace(rho: f32, integrator: &str) -> String {
+    format!(
+        r#"(
+        camera: (eye: (0.2, 0.1, 3), look_at: (0, 0, 0), fov_deg: 40),
+        render: (width: 16, height: 16, spp: 64, max_bounces: 100, integrator: {integrator}),
+        materials: {{ "m": Lambertian(reflectance: Constant({rho})) }},
+        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m") ],
+        environment: Uniform(Constant(1)),
+    )"#
+    )
+}
+
+/// Per-pixel: a pixel whose samples all hit the sphere is ρ, one whose samples
+/// all miss is 1 (edge pixels mix). The image mean is checked against the
+/// exact mean computed from the sphere's covered fraction of each pixel, which
+/// the test does not know; so instead each pixel is checked against the
+/// interval [ρ, 1] and the mean of the fully-covered centre block against ρ.
+/// Tolerance: 5 standard errors of the block mean (spread of its pixel means)
+/// plus 0.2% for f32 arithmetic.
+fn check(rho: f32, integrator: &str) {
+    let film = render_str(&furnace(rho, integrator), &SettingsPatch::default());
+    let xyz = film.mean_xyz();
+    // The sphere (radius 1 at distance ~3, fov 40°) covers the centre 8x8 block fully.
+    let block: Vec<f64> = (4..12).flat_map(|y| (4..12).map(move |x| (x, y))).map(|(x, y)| xyz[y * 16 + x][1]).collect();
+    let n = block.len() as f64;
+    let mean = block.iter().sum::<f64>() / n;
+    let se = (block.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let tol = 5.0 * se + 2e-3;
+    assert!((mean - rho as f64).abs() < tol, "{integrator}, ρ {rho}: centre Y = {mean} ± {se}");
+    // Corner pixels see only the environment: 1 with no noise over the full
+    // spectrum; sampled wavelength packets (`spectral`) read a flat spectrum out
+    // with a little colour noise (measured 0.3% at 64 spp), so 2% there.
+    let corner_tol = if integrator == "spectral" { 0.02 } else { 2e-3 };
+    for (x, y) in [(0, 0), (15, 0), (0, 15), (15, 15)] {
+        let y_val = xyz[y * 16 + x][1];
+        assert!((y_val - 1.0).abs() < corner_tol, "{integrator}: corner ({x}, {y}) Y = {y_val}");
+    }
+}
+
+#[test]
+fn white_sphere_in_a_uniform_environment_renders_one_with_every_integrator() {
+    for integrator in ["path", "bdpt", "lighttrace", "spectral", "auto"] {
+        check(1.0, integrator);
+    }
+}
+
+#[test]
+fn half_grey_sphere_renders_one_half() {
+    for integrator in ["path", "bdpt", "lighttrace"] {
+        check(0.5, integrator);
+    }
+}
+
+/// A 4x2 PNG map of one colour renders like `Uniform(Rgb(...))` of that colour:
+/// bit for bit with the path tracer (the same spectrum in every direction, and
+/// the same sampling: both draw directions, the map by its density, which is
+/// uniform per solid angle only in expectation, so compare means, not bits).
+/// Tolerance: 5 standard errors of the difference of the two image means.
+#[test]
+fn a_constant_image_map_renders_like_uniform_rgb() {
+    let dir = temp_dir("env_constant_map");
+    let (r, g, b) = (0.8f32, 0.5f32, 0.25f32);
+    // Linear values written as 16-bit sRGB codes, decoded back on load.
+    let rgb = [r, g, b];
+    let px: Vec<u16> =
+        (0..8).flat_map(|_| rgb.map(|v| (rust_v::color::srgb_oetf(v) * 65535.0).round() as u16)).collect();
+    let decoded = rgb.map(|v| rust_v::color::srgb_eotf(((rust_v::color::srgb_oetf(v) * 65535.0).round()) / 65535.0));
+    image::ImageBuffer::<image::Rgb<u16>, Vec<u16>>::from_raw(4, 2, px).unwrap().save(dir.join("map.png")).unwrap();
+    let scene = |env: &str| {
+        format!(
+            r#"(
+            camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40),
+            render: (width: 16, height: 16, spp: 64, integrator: path),
+            materials: {{ "m": Lambertian(reflectance: Rgb(0.2, 0.6, 0.9)) }},
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m") ],
+            environment: {env},
+        )"#
+        )
+    };
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, scene(r#"Image(path: "map.png")"#)).unwrap();
+    let map_scene = rust_v::scene::load_scene(&path, &SettingsPatch::default()).expect("map scene loads");
+    let uniform = render_str(
+        &scene(&format!("Uniform(Rgb({}, {}, {}))", decoded[0], decoded[1], decoded[2])),
+        &SettingsPatch::default(),
+    );
+    let mut film = rust_v::film::Film::new(16, 16);
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    rust_v::render::render(
+        &map_scene,
+        &mut film,
+        0..64,
+        rust_v::render::Limits { stop: &stop, time_budget: None },
+        &mut |_, _| {},
+    );
+    for c in 0..3 {
+        let (a, sa) = mean_and_stderr(&film, c);
+        let (b, sb) = mean_and_stderr(&uniform, c);
+        let tol = 5.0 * (sa * sa + sb * sb).sqrt() + 1e-4;
+        assert!((a - b).abs() < tol, "channel {c}: map {a} ± {sa} vs uniform {b} ± {sb}");
+    }
+    // Corner pixels (environment only) agree exactly.
+    assert_eq!(film.mean_xyz()[0], uniform.mean_xyz()[0]);
+}
