@@ -113,3 +113,72 @@ fn a_constant_image_map_renders_like_uniform_rgb() {
     // Corner pixels (environment only) agree exactly.
     assert_eq!(film.mean_xyz()[0], uniform.mean_xyz()[0]);
 }
+
+/// A map with a small bright "sun" and a dim sky lights a diffuse floor and
+/// sphere: path tracing (MIS of map sampling and BSDF sampling), BDPT (every
+/// strategy, light subpaths from the environment's disk) and light tracing
+/// (only light subpaths from the environment, plus the sky seen directly)
+/// must agree. Compared on the differences of 4x4-pixel block means (64
+/// blocks), so that the image's own content cancels: the mean difference
+/// must be within 5 standard errors (from the spread of the differences)
+/// plus 0.5% of the image mean.
+#[test]
+fn path_bdpt_and_light_tracing_agree_under_an_image_map() {
+    let dir = temp_dir("env_three_methods");
+    let (w, h) = (32u32, 16u32);
+    let mut px = vec![0.0f32; (w * h * 3) as usize];
+    for j in 0..h {
+        for i in 0..w {
+            let k = ((j * w + i) * 3) as usize;
+            let sky = if j < h / 2 { [0.3, 0.5, 0.9] } else { [0.1, 0.08, 0.05] };
+            px[k..k + 3].copy_from_slice(&sky);
+        }
+    }
+    // The sun: two texels, 200x brighter, up and to the side.
+    for i in [5u32, 6] {
+        let k = ((3 * w + i) * 3) as usize;
+        px[k..k + 3].copy_from_slice(&[60.0, 55.0, 45.0]);
+    }
+    image::Rgb32FImage::from_raw(w, h, px).unwrap().save(dir.join("map.exr")).unwrap();
+    let scene = |integrator: &str, spp: u32| {
+        format!(
+            r#"(
+            camera: (eye: (0, 1, 4), look_at: (0, 0.5, 0), fov_deg: 40),
+            render: (width: 32, height: 32, spp: {spp}, max_bounces: 6, integrator: {integrator}),
+            materials: {{ "floor": Lambertian(reflectance: Constant(0.6)), "ball": Lambertian(reflectance: Rgb(0.7, 0.3, 0.2)) }},
+            objects: [
+                (shape: Quad(origin: (-2, 0, 2), edge_u: (4, 0, 0), edge_v: (0, 0, -4)), material: "floor"),
+                (shape: Sphere(center: (0, 0.6, 0), radius: 0.6), material: "ball"),
+            ],
+            environment: Image(path: "map.exr", rotate_deg: (0, 30, 0)),
+        )"#
+        )
+    };
+    let render = |integrator: &str, spp: u32| {
+        let path = dir.join(format!("{integrator}.ron"));
+        std::fs::write(&path, scene(integrator, spp)).unwrap();
+        let scene = rust_v::scene::load_scene(&path, &SettingsPatch::default()).expect("scene loads");
+        let mut film = rust_v::film::Film::new(32, 32);
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let stats = rust_v::render::render(
+            &scene,
+            &mut film,
+            0..spp,
+            rust_v::render::Limits { stop: &stop, time_budget: None },
+            &mut |_, _| {},
+        );
+        assert_eq!(stats.invalid_samples, 0, "{integrator}: NaN samples");
+        crate::common::block_means(&film, 4)
+    };
+    let reference = render("path", 128);
+    let mean_ref = reference.iter().sum::<f64>() / reference.len() as f64;
+    for (integrator, spp) in [("bdpt", 64), ("lighttrace", 128)] {
+        let d: Vec<f64> = render(integrator, spp).iter().zip(&reference).map(|(a, b)| a - b).collect();
+        let n = d.len() as f64;
+        let m = d.iter().sum::<f64>() / n;
+        let se = (d.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let tol = 5.0 * se + 5e-3 * mean_ref;
+        eprintln!("{integrator}: {m} ± {se}, tol {tol}, mean {mean_ref}");
+        assert!(m.abs() < tol, "{integrator}: mean Y differs from path by {m} ± {se} (image mean {mean_ref})");
+    }
+}

@@ -944,3 +944,52 @@ fn coincident_dielectrics_warn_and_behave_as_documented() {
     let o = run(&["render", s(&path), "-q", "-o", s(&d.join("o.png"))]);
     assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
 }
+
+// ---------------------------------------------------------------------------
+// Environment maps.
+
+/// Bad environment maps and values: one error line naming the field, never a
+/// panic. A 1x1 map is a valid (uniform) map.
+#[test]
+fn bad_environment_maps_are_one_error_naming_the_field() {
+    let dir = temp_dir("hostile_env");
+    let good = |px: Vec<f32>, w: u32, h: u32, name: &str| {
+        image::Rgb32FImage::from_raw(w, h, px).unwrap().save(dir.join(name)).unwrap();
+    };
+    good(vec![f32::NAN, 1.0, 1.0, 1.0, 1.0, 1.0], 2, 1, "nan.exr");
+    good(vec![1.0, 1.0, 1.0, 1.0, -2.0, 1.0], 2, 1, "negative.exr");
+    good(vec![0.0; 6], 2, 1, "black.exr");
+    good(vec![0.5, 0.4, 0.3], 1, 1, "one.exr");
+    std::fs::write(dir.join("text.png"), "not an image").unwrap();
+    let full = std::fs::read(dir.join("one.exr")).unwrap();
+    std::fs::write(dir.join("truncated.exr"), &full[..full.len() / 2]).unwrap();
+    let scene = |env: &str| {
+        format!(
+            r#"(camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40), render: (width: 8, height: 8, spp: 1),
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m") ],
+            materials: {{ "m": Lambertian(reflectance: Constant(0.5)) }},
+            environment: {env})"#
+        )
+    };
+    let out = dir.join("out.png");
+    for (env, field, what) in [
+        (r#"Image(path: "missing.exr")"#, "environment.path", "missing.exr"),
+        (r#"Image(path: "text.png")"#, "environment.path", "decode"),
+        (r#"Image(path: "truncated.exr")"#, "environment.path", "decode"),
+        (r#"Image(path: "nan.exr")"#, "environment.path", "texel (0, 0)"),
+        (r#"Image(path: "negative.exr")"#, "environment.path", "texel (1, 0)"),
+        (r#"Image(path: "black.exr")"#, "environment.path", "black"),
+        (r#"Image(path: "one.exr", scale: -1)"#, "environment.scale", "positive"),
+        (r#"Image(path: "one.exr", rotate_deg: (0, inf, 0))"#, "environment.rotate_deg", "finite"),
+        ("Uniform(Constant(0))", "environment", "black"),
+        ("Uniform(Constant(-1))", "environment.Uniform", ""),
+    ] {
+        let p = scene_in(&dir, &scene(env));
+        let o = run(&["render", s(&p), "-o", s(&out)]);
+        let e = one_error(&o, 1);
+        assert!(e.contains(field) && e.contains(what), "{env}: {e}");
+    }
+    let p = scene_in(&dir, &scene(r#"Image(path: "one.exr")"#));
+    let o = run(&["render", s(&p), "-o", s(&out)]);
+    assert!(o.status.success(), "a 1x1 map: {}", stderr(&o));
+}
