@@ -47,5 +47,6 @@ pub mod settings;
 pub mod shape;
 pub(crate) mod spectral;
 pub mod study;
+pub mod texture;
 
 pub use error::{Error, Result};

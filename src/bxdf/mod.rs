@@ -100,6 +100,23 @@ pub enum Bxdf {
 }
 
 impl Bxdf {
+    /// The same lobe with reflectance `r` (a texture's value at a hit) for the
+    /// models whose reflectance may be textured (Lambertian, Oren-Nayar,
+    /// mirror, plastic); any other model unchanged.
+    pub fn with_reflectance(&self, r: Spectrum) -> Bxdf {
+        match self {
+            Bxdf::Lambertian(_) => Bxdf::Lambertian(Lambertian { reflectance: r }),
+            Bxdf::OrenNayar(o) => {
+                let mut o = *o;
+                o.reflectance = r;
+                Bxdf::OrenNayar(o)
+            }
+            Bxdf::Mirror(_) => Bxdf::Mirror(Mirror { reflectance: r }),
+            Bxdf::Plastic(p) => Bxdf::Plastic(p.with_reflectance(r)),
+            other => other.clone(),
+        }
+    }
+
     /// `f(wo, wi)` for the packet (zero for delta models).
     #[inline]
     pub fn eval<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {

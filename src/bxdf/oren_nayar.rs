@@ -17,7 +17,7 @@ use crate::color::Spectrum;
 use crate::spectral::Lambdas;
 
 /// Oren-Nayar reflection.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct OrenNayar {
     /// Reflectance ρ(λ) in [0, 1].
     pub reflectance: Spectrum,

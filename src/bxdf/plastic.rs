@@ -38,7 +38,7 @@ use crate::sampler::warp::{cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectral::Lambdas;
 
 /// A coated diffuse surface.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct Plastic {
     /// The base's diffuse reflectance ρ.
     reflectance: Spectrum,
@@ -46,6 +46,9 @@ pub struct Plastic {
     eta: Spectrum,
     /// The diffuse scale per bin, `ρ / (π η² (1 − ρ F_dr))`.
     diffuse: Spectrum,
+    /// The coat's hemispherical reflectance from outside per bin, `F_dr,out(η)`
+    /// (kept so a texture can change ρ per hit without the integral).
+    f_dr_out: Spectrum,
     /// GGX α of the coat (below 1e-3: smooth).
     alpha: f32,
 }
@@ -66,15 +69,27 @@ impl Plastic {
     /// A plastic of base reflectance `reflectance`, coat index `ior` and GGX α `alpha`.
     pub fn new(reflectance: Spectrum, ior: &Ior, alpha: f32) -> Self {
         let eta = Spectrum::from_fn(|b| ior.at(bin_lambda_nm(b)).max(1e-3));
-        let diffuse = Spectrum::from_fn(|b| {
+        let f_dr_out = Spectrum::from_fn(|b| external_diffuse_reflectance(eta[b]));
+        let diffuse = Self::diffuse_scale(&reflectance, &eta, &f_dr_out);
+        Plastic { reflectance, eta, diffuse, f_dr_out, alpha }
+    }
+
+    /// The same coat over another base reflectance (a texture's value at a hit).
+    pub fn with_reflectance(&self, reflectance: Spectrum) -> Self {
+        let diffuse = Self::diffuse_scale(&reflectance, &self.eta, &self.f_dr_out);
+        Plastic { reflectance, diffuse, ..*self }
+    }
+
+    /// `ρ / (π η² (1 − ρ F_dr,in))` per bin.
+    fn diffuse_scale(reflectance: &Spectrum, eta: &Spectrum, f_dr_out: &Spectrum) -> Spectrum {
+        Spectrum::from_fn(|b| {
             let (rho, e) = (reflectance[b], eta[b]);
             // η² (1 − ρ F_dr,in) = η² (1 − ρ) + ρ (1 − F_dr,out) by the identity in the
             // module docs: stable where F_dr,in → 1 (large η, white base).
-            let denom = e * e * (1.0 - rho) + rho * (1.0 - external_diffuse_reflectance(e));
+            let denom = e * e * (1.0 - rho) + rho * (1.0 - f_dr_out[b]);
             let v = rho * FRAC_1_PI / denom;
             if v.is_finite() && denom > 0.0 { v } else { 0.0 }
-        });
-        Plastic { reflectance, eta, diffuse, alpha }
+        })
     }
 
     /// The base reflectance.

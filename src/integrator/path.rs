@@ -182,7 +182,7 @@ impl PathTracer {
             if w.bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = scene.bsdf(si.object);
+            let bxdf = &*scene.bsdf_at(&si);
             if bxdf.is_black() {
                 break;
             }

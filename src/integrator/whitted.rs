@@ -75,7 +75,7 @@ impl Whitted {
             if bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = scene.bsdf(si.object);
+            let bxdf = &*scene.bsdf_at(&si);
             if bxdf.is_black() {
                 break;
             }

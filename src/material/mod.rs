@@ -1,11 +1,15 @@
 //! Materials: a material is built from its description once at load; `bxdf/`
 //! stays the pure lobes (reflection models that know nothing of the scene
-//! format); textures (issue 35) will make this per-hit evaluation.
+//! format).
 //!
 //! Data flow: `MaterialDesc` (the RON text, [`crate::scene::desc`]) →
 //! `from_desc` here (checks every field, looks up named metals and glasses,
 //! builds spectra and indices) → [`Bxdf`] (stored once per named material in
-//! [`crate::scene::Scene::materials`]; objects refer to it by index).
+//! [`crate::scene::Scene::materials`]; objects refer to it by index), and,
+//! where the reflectance is a texture (`Image`, `Checkerboard`: Lambertian,
+//! OrenNayar, Mirror and Plastic), the [`Texture`] beside it, which
+//! [`crate::scene::Scene::bsdf_at`] evaluates at each hit
+//! ([`Bxdf::with_reflectance`]).
 //!
 //! Errors name the scene file and the field path
 //! (`materials."gold".roughness`) and what was expected.
@@ -16,27 +20,53 @@ use crate::bxdf::{
 use crate::color::{self, N_BINS};
 use crate::error::Result;
 use crate::scene::check::Check;
-use crate::scene::desc::{CoatingDesc, IorDesc, MaterialDesc};
+use crate::scene::desc::{CoatingDesc, IorDesc, MaterialDesc, SpectrumDesc};
+use crate::texture::{self, Texture};
 
-/// The [`Bxdf`] of a material description at `field` (`materials."name"`).
-pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<Bxdf> {
+/// The [`Bxdf`] of a material description at `field` (`materials."name"`), and
+/// its reflectance texture if it has one.
+pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<(Bxdf, Option<Texture>)> {
+    let texture = match d {
+        MaterialDesc::Lambertian { reflectance }
+        | MaterialDesc::OrenNayar { reflectance, .. }
+        | MaterialDesc::Mirror { reflectance }
+        | MaterialDesc::Plastic { reflectance, .. } => {
+            texture::from_desc(check, &format!("{field}.reflectance"), reflectance)?
+        }
+        _ => None,
+    };
+    // A textured material's lobe is built with a stand-in reflectance (grey ½),
+    // replaced at every hit.
+    const STAND_IN: &SpectrumDesc = &SpectrumDesc::Constant(0.5);
+    let textured = texture.is_some();
+    let bxdf = bxdf_of(check, field, d, |r| if textured { STAND_IN } else { r })?;
+    Ok((bxdf, texture))
+}
+
+/// The [`Bxdf`] of a material description, its reflectance description passed through `reflectance`.
+fn bxdf_of<'a>(
+    check: &Check,
+    field: &str,
+    d: &'a MaterialDesc,
+    reflectance: impl Fn(&'a SpectrumDesc) -> &'a SpectrumDesc,
+) -> Result<Bxdf> {
     Ok(match d {
-        MaterialDesc::Lambertian { reflectance } => Bxdf::Lambertian(Lambertian {
-            reflectance: check.reflectance(&format!("{field}.reflectance"), reflectance)?,
+        MaterialDesc::Lambertian { reflectance: r } => Bxdf::Lambertian(Lambertian {
+            reflectance: check.reflectance(&format!("{field}.reflectance"), reflectance(r))?,
         }),
-        MaterialDesc::OrenNayar { reflectance, sigma_deg } => {
+        MaterialDesc::OrenNayar { reflectance: r, sigma_deg } => {
             if !(sigma_deg.is_finite() && (0.0..=90.0).contains(sigma_deg)) {
                 return Err(
                     check.err(format!("{field}.sigma_deg"), format!("expected degrees in [0, 90], found {sigma_deg}"))
                 );
             }
             Bxdf::OrenNayar(OrenNayar::new(
-                check.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                check.reflectance(&format!("{field}.reflectance"), reflectance(r))?,
                 *sigma_deg,
             ))
         }
-        MaterialDesc::Mirror { reflectance } => {
-            Bxdf::Mirror(Mirror { reflectance: check.reflectance(&format!("{field}.reflectance"), reflectance)? })
+        MaterialDesc::Mirror { reflectance: r } => {
+            Bxdf::Mirror(Mirror { reflectance: check.reflectance(&format!("{field}.reflectance"), reflectance(r))? })
         }
         MaterialDesc::Dielectric { ior, roughness, absorption, coating } => {
             let mut d = Dielectric::new(check.ior(&format!("{field}.ior"), ior)?).with_roughness(ggx_alpha(
@@ -81,7 +111,7 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<
             let alpha = ggx_alpha(check, &format!("{field}.roughness"), *roughness)?;
             Bxdf::Conductor(Conductor { eta, k, alpha, coating })
         }
-        MaterialDesc::Plastic { reflectance, ior, roughness } => {
+        MaterialDesc::Plastic { reflectance: r, ior, roughness } => {
             let ior = check.ior(&format!("{field}.ior"), ior)?;
             for b in 0..N_BINS {
                 let n = ior.at(color::bin_lambda_nm(b));
@@ -93,7 +123,7 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<
                 }
             }
             Bxdf::Plastic(Plastic::new(
-                check.reflectance(&format!("{field}.reflectance"), reflectance)?,
+                check.reflectance(&format!("{field}.reflectance"), reflectance(r))?,
                 &ior,
                 ggx_alpha(check, &format!("{field}.roughness"), *roughness)?,
             ))

@@ -153,9 +153,51 @@ pub enum SpectrumDesc {
     /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
     /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
     Rgb(f32, f32, f32),
+    /// An image texture (a material's reflectance only; see `crate::texture`):
+    /// `Image(path: "wood.png", uv_scale: (2, 2), uv_offset: (0, 0), wrap: Repeat, scale: 1)`.
+    Image {
+        /// A PNG (sRGB) or EXR (linear) file, relative to the scene file.
+        path: String,
+        /// Multiplies (u, v) before the lookup (default `(1, 1)`).
+        #[serde(default = "ones2")]
+        uv_scale: [f32; 2],
+        /// Added to (u, v) after `uv_scale` (default `(0, 0)`).
+        #[serde(default)]
+        uv_offset: [f32; 2],
+        /// Outside [0, 1]: `Repeat` (default) or `Clamp`.
+        #[serde(default)]
+        wrap: Wrap,
+        /// A factor on every texel (default 1); the product is clamped to [0, 1].
+        #[serde(default = "one")]
+        scale: f32,
+    },
+    /// A checkerboard over (u, v) (a material's reflectance only):
+    /// `Checkerboard(even: Constant(0.8), odd: Rgb(0.1, 0.1, 0.3), scale: 8)`.
+    Checkerboard {
+        /// The squares where `⌊N u⌋ + ⌊N v⌋` is even.
+        even: Box<SpectrumDesc>,
+        /// The other squares.
+        odd: Box<SpectrumDesc>,
+        /// `N`, squares per unit of u and of v.
+        scale: f32,
+    },
     /// A spectrum scaled to the given luminance Y (a flat spectrum of 1 has Y = 1):
     /// `Luminance(5, Blackbody(3000))` is a 3000 K emitter as bright as `Constant(5)`.
     Luminance(f32, Box<SpectrumDesc>),
+}
+
+/// How an image texture continues outside [0, 1].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+pub enum Wrap {
+    /// Periodically (the default).
+    #[default]
+    Repeat,
+    /// The edge texels extend outwards.
+    Clamp,
+}
+
+fn ones2() -> [f32; 2] {
+    [1.0, 1.0]
 }
 
 /// An index of refraction in the scene file.

@@ -148,10 +148,13 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
 
     // Materials by name; index 0 is the implicit black material of lights.
     let mut materials = vec![Bxdf::Black];
+    let mut textures = vec![None];
     let mut by_name = BTreeMap::new();
     for (name, m) in &desc.materials.0 {
         by_name.insert(name.as_str(), materials.len() as u32);
-        materials.push(material::from_desc(ctx, &format!("materials.\"{name}\""), m)?);
+        let (bxdf, texture) = material::from_desc(ctx, &format!("materials.\"{name}\""), m)?;
+        materials.push(bxdf);
+        textures.push(texture);
     }
 
     // Every mesh file is read, parsed and built (with its BVH) at once on the
@@ -237,7 +240,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {}", c.fov_deg)));
     }
     let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height);
-    Ok(Scene::new(objects, materials, lights, camera, settings, 0))
+    Ok(Scene::new(objects, materials, textures, lights, camera, settings, 0))
 }
 
 /// Combines defaults, the file's `render` block and the command line, and checks the result.

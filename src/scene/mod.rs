@@ -25,6 +25,7 @@ use crate::medium::{Medium, VOLUME_STACK_DEPTH, Volume, VolumeStack};
 use crate::settings::Settings;
 use crate::shape::Shape;
 use crate::shape::{Batch, Bvh};
+use crate::texture::Texture;
 
 /// Below this many bounded objects the scene tests them one by one instead of
 /// building a BVH over them. Measured with callgrind (instructions for a 32x32,
@@ -65,6 +66,9 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Materials (objects refer to them by index).
     pub materials: Vec<Bxdf>,
+    /// Each material's reflectance texture, if it has one (index for index
+    /// with `materials`; empty when no material has one).
+    textures: Vec<Option<Texture>>,
     /// Lights (area lights refer back to their object).
     pub lights: Vec<Light>,
     /// Probability of choosing each light for next-event estimation (∝ power).
@@ -116,6 +120,7 @@ impl Scene {
     pub fn new(
         objects: Vec<Object>,
         materials: Vec<Bxdf>,
+        textures: Vec<Option<Texture>>,
         mut lights: Vec<Light>,
         camera: Camera,
         settings: Settings,
@@ -166,7 +171,9 @@ impl Scene {
             .collect();
         let dispersive = objects.iter().any(|o| materials.get(o.material as usize).is_some_and(Bxdf::is_dispersive));
         let environment = lights.iter().position(Light::is_infinite).map(|i| i as u32);
+        let textures = if textures.iter().any(Option::is_some) { textures } else { Vec::new() };
         Scene {
+            textures,
             environment,
             radius,
             dispersive,

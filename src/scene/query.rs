@@ -9,7 +9,7 @@
 //! |---|---|
 //! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: point, normals, primitive, object) |
 //! | the surface coordinates of a hit, for a texture lookup | [`Scene::uv`] (on demand: nothing computes them during traversal) |
-//! | the BSDF at a surface | [`Scene::bsdf`] |
+//! | the BSDF at a surface | [`Scene::bsdf_at`] (textures evaluated at the hit); [`Scene::bsdf`] for what no texture changes |
 //! | emission leaving a surface hit | [`Scene::le`], and its light-sampling density for MIS, [`Scene::pdf_li`] |
 //! | a point on a light towards a shading point | [`Scene::sample_li`] |
 //! | a ray leaving a light (BDPT, light tracing) | [`Scene::light`] then [`crate::light::Light::sample_le`] |
@@ -22,7 +22,9 @@
 //! when the scene has one, else nothing: every integrator's escape branch
 //! asks [`Scene::escaped`].
 
-use glam::Vec3;
+use std::borrow::Cow;
+
+use glam::{Vec2, Vec3};
 
 use super::{Scene, SurfaceHit};
 use crate::bxdf::{Bxdf, Outside};
@@ -31,6 +33,7 @@ use crate::geometry::Ray;
 use crate::light::{Light, LightSample};
 use crate::medium::{Crossing, Medium, Volume, VolumeStack};
 use crate::spectral::Lambdas;
+use crate::texture::Texture;
 
 /// The most false intersections a path or a segment passes in a row before it
 /// ends (a guard against degenerate geometry; real scenes need a handful).
@@ -67,10 +70,42 @@ impl Scene {
         self.objects[si.object as usize].shape.uv(&si.hit)
     }
 
-    /// The BSDF of object `object`'s material.
+    /// The BSDF of object `object`'s material, untextured: for what does not
+    /// depend on a texture (whether it is delta, black, dispersive; its
+    /// dielectric index); the lobe at a hit is [`Scene::bsdf_at`].
     #[inline]
     pub fn bsdf(&self, object: u32) -> &Bxdf {
         &self.materials[self.objects[object as usize].material as usize]
+    }
+
+    /// The BSDF at surface hit `si`: its material's, with a textured
+    /// reflectance evaluated at the hit's (u, v) (once per call; a scene
+    /// without textures pays one branch).
+    #[inline]
+    pub fn bsdf_at(&self, si: &SurfaceHit) -> Cow<'_, Bxdf> {
+        match self.texture(si.object) {
+            Some(t) => Cow::Owned(self.bsdf(si.object).with_reflectance(t.eval(self.uv(si)))),
+            None => Cow::Borrowed(self.bsdf(si.object)),
+        }
+    }
+
+    /// The BSDF of object `object` at surface coordinates `uv` (as [`Scene::bsdf_at`],
+    /// for a path vertex that kept its (u, v)).
+    #[inline]
+    pub fn bsdf_uv(&self, object: u32, uv: Vec2) -> Cow<'_, Bxdf> {
+        match self.texture(object) {
+            Some(t) => Cow::Owned(self.bsdf(object).with_reflectance(t.eval(uv))),
+            None => Cow::Borrowed(self.bsdf(object)),
+        }
+    }
+
+    /// The reflectance texture of object `object`'s material, if it has one.
+    #[inline]
+    pub fn texture(&self, object: u32) -> Option<&Texture> {
+        if self.textures.is_empty() {
+            return None;
+        }
+        self.textures[self.objects[object as usize].material as usize].as_ref()
     }
 
     /// The medium outside a dielectric surface whose outside volume has

@@ -105,6 +105,12 @@ impl Check<'_> {
                     ),
                 )
             })?,
+            SpectrumDesc::Image { .. } | SpectrumDesc::Checkerboard { .. } => {
+                return Err(self.err(
+                    field,
+                    "a texture (Image, Checkerboard) can stand only for a material's reflectance; expected a spectrum",
+                ));
+            }
             SpectrumDesc::D65 => color::d65(),
             SpectrumDesc::EqualEnergy => color::equal_energy(),
             SpectrumDesc::Blackbody(t) => color::blackbody(*t)

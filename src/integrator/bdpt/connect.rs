@@ -11,7 +11,7 @@ use crate::spectral::Lambdas;
 
 use super::mis::{Overrides, mis_weight};
 use super::vertex::{
-    Contrib, Kind, Vertex, Wavelength, connectible, is_dispersive, material, outside, pdf_at, pdf_light,
+    Contrib, Kind, Vertex, Wavelength, bsdf_at, connectible, is_dispersive, outside, pdf_at, pdf_light,
     shading_correction, to_area,
 };
 use super::{Bdpt, Sub};
@@ -59,7 +59,7 @@ impl Bdpt {
                 if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
             }
             Kind::Surface(o) => {
-                let bxdf = material(scene, o);
+                let bxdf = bsdf_at(scene, o, qs);
                 let wi = qs.sh.frame.to_local(w);
                 if !qs.sh.consistent(w, wi) {
                     return None;
@@ -160,7 +160,7 @@ impl Bdpt {
                 if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
                 }
-                let bxdf = material(scene, object);
+                let bxdf = bsdf_at(scene, object, pt);
                 let out = outside(scene, pt.outside);
                 let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
@@ -207,7 +207,7 @@ impl Bdpt {
                 if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
                     return NONE;
                 }
-                let (bp, bq) = (material(scene, object), material(scene, q_object));
+                let (bp, bq) = (bsdf_at(scene, object, pt), bsdf_at(scene, q_object, qs));
                 let (op, oq) = (outside(scene, pt.outside), outside(scene, qs.outside));
                 let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
                 let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {

@@ -1,9 +1,10 @@
 //! Subpath vertices, the sample's collapsed wavelength, and the densities and
 //! material queries a vertex answers.
 
+use std::borrow::Cow;
 use std::sync::LazyLock;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::bxdf::{Bxdf, Outside};
 use crate::color::{N_BINS, Spectrum};
@@ -49,13 +50,26 @@ pub(super) struct Vertex {
     /// At a dielectric's surface, the material of the medium on its outside
     /// (`None`: vacuum, or not a dielectric).
     pub(super) outside: Option<u32>,
+    /// The surface coordinates, where the material is textured (else zero).
+    pub(super) uv: Vec2,
 }
 
 impl Vertex {
     pub(super) fn at_point(kind: Kind, p: Vec3, n: Vec3, beta: Spectrum, pdf_fwd: f32) -> Vertex {
         let frame = Frame::from_z(if n == Vec3::ZERO { Vec3::Z } else { n });
         let sh = Shading { p, n, frame, wo: Vec3::Z, wo_n: 0.0 };
-        Vertex { kind, sh, beta, delta: false, collapsed: false, pdf_fwd, pdf_rev: 0.0, g_prev: 0.0, outside: None }
+        Vertex {
+            kind,
+            sh,
+            beta,
+            delta: false,
+            collapsed: false,
+            pdf_fwd,
+            pdf_rev: 0.0,
+            g_prev: 0.0,
+            outside: None,
+            uv: Vec2::ZERO,
+        }
     }
 
     #[inline]
@@ -145,10 +159,17 @@ pub(super) fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 
     if c.is_finite() { c } else { 0.0 }
 }
 
-/// The material of object `o`.
+/// The material of object `o`, untextured: for what no texture changes
+/// (delta, dispersive, black).
 #[inline]
 pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
     scene.bsdf(o)
+}
+
+/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the vertex's (u, v)).
+#[inline]
+pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex) -> Cow<'s, Bxdf> {
+    scene.bsdf_uv(o, v.uv)
 }
 
 /// True when a connection can end at `v`: a surface whose material has a
@@ -201,7 +222,7 @@ pub(super) fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -
 #[inline]
 pub(super) fn pdf_at(scene: &Scene, v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
     match v.kind {
-        Kind::Surface(o) => material(scene, o).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside)),
+        Kind::Surface(o) => bsdf_at(scene, o, v).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside)),
         _ => 0.0,
     }
 }

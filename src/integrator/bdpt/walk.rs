@@ -10,7 +10,7 @@ use crate::scene::Scene;
 use crate::spectral::Lambdas;
 
 use super::RR_DEPTH;
-use super::vertex::{Kind, Vertex, Wavelength, material, outside, shading_correction, to_area};
+use super::vertex::{Kind, Vertex, Wavelength, outside, shading_correction, to_area};
 
 /// A subpath walk's fixed parameters.
 pub(super) struct Walk {
@@ -64,7 +64,9 @@ impl Walk {
                 break;
             };
             let hit = si.hit;
-            let bxdf = material(scene, si.object);
+            let textured = scene.texture(si.object).is_some();
+            let uv = if textured { scene.uv(&si) } else { glam::Vec2::ZERO };
+            let bxdf = scene.bsdf_uv(si.object, uv);
             // Beer-Lambert along the segment, in the medium it ran in.
             if let Some(medium) = scene.medium_in(media.current()) {
                 if collapsed {
@@ -111,6 +113,7 @@ impl Walk {
                 pdf_rev: 0.0,
                 g_prev: 0.0,
                 outside: outside_material,
+                uv,
             };
             v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, prev, &v) };
             v.g_prev = to_area(scene, 1.0, &v, prev);

@@ -1,0 +1,274 @@
+//! Textures: a material's reflectance that varies over its surface, looked up
+//! at a hit's (u, v) (each shape's parameterisation is in `shape/uv.rs`).
+//!
+//! ```ron
+//! "floor": Lambertian(reflectance: Checkerboard(even: Constant(0.8), odd: Rgb(0.1, 0.1, 0.3), scale: 8)),
+//! "wall": Lambertian(reflectance: Image(path: "textures/wood.png", uv_scale: (2, 1), wrap: Repeat)),
+//! ```
+//!
+//! Data flow: the material's `reflectance:` ([`crate::scene::desc::SpectrumDesc`])
+//! is built once at load into a [`Texture`]; a material whose reflectance is
+//! not constant keeps it beside its [`crate::bxdf::Bxdf`], and
+//! [`crate::scene::Scene::bsdf_at`] evaluates it once per hit (the lobe with
+//! the texel's reflectance in place of the constant one). A scene without
+//! textures never computes a (u, v) and pays one branch per hit.
+//!
+//! - `Image(path, uv_scale: (su, sv), uv_offset: (ou, ov), wrap: Repeat | Clamp, scale: S)`:
+//!   a PNG (8 or 16 bits per channel, sRGB-decoded to linear with the
+//!   IEC 61966-2-1 transfer function) or an EXR (linear). The lookup point is
+//!   `(u·su + ou, v·sv + ov)`, with `v = 0` at the image's **bottom** row
+//!   (OBJ's and pbrt's convention: the image is not upside down on a mesh
+//!   with `vt`), filtered bilinearly between texel centres; `Repeat` wraps
+//!   outside [0, 1], `Clamp` holds the edge texels. Each texel's colour,
+//!   times `S`, becomes a reflectance as `Rgb(...)` does (the Jakob-Hanika
+//!   sigmoid, fitted per texel at load: see [`crate::color::Uplift`]), so an
+//!   image of one colour renders exactly like that `Rgb(...)`.
+//! - `Checkerboard(even, odd, scale: N)`: `N` squares per unit of u and of v;
+//!   the square `(⌊N u⌋, ⌊N v⌋)` is `even` when the sum is even.
+
+use std::sync::Arc;
+
+use glam::Vec2;
+
+use crate::color::{Spectrum, Uplift};
+use crate::error::Result;
+use crate::io::image::{Pixels, decode_image};
+use crate::scene::check::Check;
+use crate::scene::desc::{SpectrumDesc, Wrap};
+
+/// The most texels an image texture may have (a 8192 x 8192 image).
+pub const MAX_TEXELS: usize = 1 << 26;
+
+/// A reflectance over a surface.
+#[derive(Clone, Debug)]
+pub enum Texture {
+    /// Two reflectances in a checkerboard over (u, v).
+    Checkerboard {
+        /// Where `⌊N u⌋ + ⌊N v⌋` is even.
+        even: Spectrum,
+        /// Where it is odd.
+        odd: Spectrum,
+        /// Squares per unit of u and of v.
+        scale: f32,
+    },
+    /// An image.
+    Image(Arc<ImageTexture>),
+}
+
+/// An image of uplifted reflectance texels.
+#[derive(Clone, Debug)]
+pub struct ImageTexture {
+    width: usize,
+    height: usize,
+    /// Row 0 is the image's top row.
+    texels: Vec<Uplift>,
+    uv_scale: Vec2,
+    uv_offset: Vec2,
+    wrap: Wrap,
+}
+
+impl Texture {
+    /// The reflectance at surface coordinates `uv`.
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> Spectrum {
+        match self {
+            Texture::Checkerboard { even, odd, scale } => {
+                let (i, j) = ((uv.x * scale).floor() as i64, (uv.y * scale).floor() as i64);
+                if (i + j).rem_euclid(2) == 0 { *even } else { *odd }
+            }
+            Texture::Image(image) => image.eval(uv),
+        }
+    }
+}
+
+impl ImageTexture {
+    /// An image texture of `width` x `height` linear sRGB reflectances (row 0
+    /// at the top), each times `scale`; errors name no field (the caller does).
+    pub fn new(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        scale: f32,
+        uv_scale: Vec2,
+        uv_offset: Vec2,
+        wrap: Wrap,
+    ) -> Result<ImageTexture, String> {
+        if width == 0 || height == 0 || rgb.len() != width * height {
+            return Err(format!("expected a non-empty image, found {width}x{height}"));
+        }
+        if width * height > MAX_TEXELS {
+            return Err(format!("{width}x{height} is more than the {MAX_TEXELS} texels a texture may have"));
+        }
+        if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
+        }
+        let texels = fit_rows(width, rgb, scale);
+        Ok(ImageTexture { width, height, texels, uv_scale, uv_offset, wrap })
+    }
+
+    /// The bilinear blend of the four texels around `uv` (see the module doc).
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> Spectrum {
+        let st = uv * self.uv_scale + self.uv_offset;
+        let x = st.x * self.width as f32 - 0.5;
+        let y = (1.0 - st.y) * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (i0, i1) = (self.index(x0, self.width), self.index(x0 + 1.0, self.width));
+        let (j0, j1) = (self.index(y0, self.height), self.index(y0 + 1.0, self.height));
+        let t = [
+            (self.texels[j0 * self.width + i0], (1.0 - fx) * (1.0 - fy)),
+            (self.texels[j0 * self.width + i1], fx * (1.0 - fy)),
+            (self.texels[j1 * self.width + i0], (1.0 - fx) * fy),
+            (self.texels[j1 * self.width + i1], fx * fy),
+        ];
+        if t.iter().all(|(texel, _)| *texel == t[0].0) {
+            return t[0].0.spectrum();
+        }
+        let mut s = Spectrum::ZERO;
+        for (texel, weight) in t {
+            if weight > 0.0 {
+                s += texel.spectrum() * weight;
+            }
+        }
+        s
+    }
+
+    /// Texel index along an axis of `n` texels for the integer coordinate `x`.
+    #[inline]
+    fn index(&self, x: f32, n: usize) -> usize {
+        // Far outside (or NaN) the coordinate saturates; both modes stay in range.
+        let x = if x.is_finite() { x.clamp(-1e9, 1e9) as i64 } else { 0 };
+        match self.wrap {
+            Wrap::Repeat => x.rem_euclid(n as i64) as usize,
+            Wrap::Clamp => x.clamp(0, n as i64 - 1) as usize,
+        }
+    }
+}
+
+/// Every texel's reflectance uplift, `scale` folded in: rows in parallel,
+/// each fit along a row starting from the previous texel's coefficients, a
+/// repeated colour reusing them (see [`Uplift::reflectance`]).
+fn fit_rows(width: usize, rgb: &[[f32; 3]], scale: f32) -> Vec<Uplift> {
+    use rayon::prelude::*;
+    let rows: Vec<Vec<Uplift>> = rgb
+        .par_chunks(width)
+        .map(|row| {
+            let mut out = Vec::with_capacity(width);
+            let mut prev: Option<([f32; 3], Uplift)> = None;
+            for &p in row {
+                let c = p.map(|v| v * scale);
+                let texel = match prev {
+                    Some((pc, t)) if pc == c => t,
+                    _ => Uplift::reflectance(c, prev.map(|(_, t)| t.coefficients())),
+                };
+                prev = Some((c, texel));
+                out.push(texel);
+            }
+            out
+        })
+        .collect();
+    rows.concat()
+}
+
+/// The reflectance at field `field`: a [`Texture`] for `Image` and
+/// `Checkerboard`, else `None` (the caller builds the constant spectrum).
+pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
+    Ok(Some(match d {
+        SpectrumDesc::Checkerboard { even, odd, scale } => Texture::Checkerboard {
+            even: check.reflectance(&format!("{field}.even"), even)?,
+            odd: check.reflectance(&format!("{field}.odd"), odd)?,
+            scale: check.positive(&format!("{field}.scale"), *scale)?,
+        },
+        SpectrumDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
+            let path_field = format!("{field}.path");
+            let scale = check.positive(&format!("{field}.scale"), *scale)?;
+            let finite2 = |name: &str, v: [f32; 2]| {
+                if v.iter().all(|c| c.is_finite()) {
+                    Ok(Vec2::from(v))
+                } else {
+                    Err(check.err(format!("{field}.{name}"), format!("expected finite numbers, found {v:?}")))
+                }
+            };
+            let (uv_scale, uv_offset) = (finite2("uv_scale", *uv_scale)?, finite2("uv_offset", *uv_offset)?);
+            let (resolved, bytes) = check.read_input(&path_field, path)?;
+            let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
+            let rgb: Vec<[f32; 3]> = match pixels {
+                Pixels::Linear(p) => p.into_iter().map(|c| c.map(|v| v as f32)).collect(),
+                Pixels::Code16(p) => {
+                    p.into_iter().map(|c| c.map(|v| crate::color::srgb_eotf(v as f32 / 65535.0))).collect()
+                }
+            };
+            let image = ImageTexture::new(w as usize, h as usize, &rgb, scale, uv_scale, uv_offset, *wrap)
+                .map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
+            Texture::Image(Arc::new(image))
+        }
+        _ => return Ok(None),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(w: usize, h: usize, rgb: &[[f32; 3]], wrap: Wrap) -> ImageTexture {
+        ImageTexture::new(w, h, rgb, 1.0, Vec2::ONE, Vec2::ZERO, wrap).unwrap()
+    }
+
+    /// Bilinear weights: at a texel's centre the texel itself; halfway between
+    /// two horizontal neighbours their mean; v = 0 is the bottom row.
+    #[test]
+    fn bilinear_weights_and_orientation() {
+        // 2x2 greys: top row 0.2, 0.4; bottom row 0.6, 0.8.
+        let t = image(2, 2, &[[0.2; 3], [0.4; 3], [0.6; 3], [0.8; 3]], Wrap::Clamp);
+        let at = |u: f32, v: f32| t.eval(Vec2::new(u, v))[0];
+        assert_eq!(at(0.25, 0.75), 0.2, "top-left texel centre");
+        assert_eq!(at(0.75, 0.25), 0.8, "bottom-right texel centre");
+        assert!((at(0.5, 0.75) - 0.3).abs() < 1e-6, "halfway along the top row");
+        assert!((at(0.5, 0.5) - 0.5).abs() < 1e-6, "the centre: all four equally");
+        // Weights 3/4 and 1/4 a quarter of the way.
+        assert!((at(0.375, 0.75) - (0.75 * 0.2 + 0.25 * 0.4)).abs() < 1e-6);
+    }
+
+    /// Wrap modes outside [0, 1]: Repeat is periodic, Clamp holds the edge.
+    #[test]
+    fn wrap_modes() {
+        let px = [[0.1; 3], [0.9; 3]];
+        let rep = image(2, 1, &px, Wrap::Repeat);
+        let cla = image(2, 1, &px, Wrap::Clamp);
+        for u in [0.25f32, 0.75] {
+            assert_eq!(rep.eval(Vec2::new(u + 3.0, 0.5)), rep.eval(Vec2::new(u, 0.5)));
+            assert_eq!(rep.eval(Vec2::new(u - 5.0, 0.5)), rep.eval(Vec2::new(u, 0.5)));
+        }
+        assert_eq!(cla.eval(Vec2::new(7.0, 0.5))[0], 0.9);
+        assert_eq!(cla.eval(Vec2::new(-7.0, 0.5))[0], 0.1);
+        // Repeat blends across the seam: at u = 0 the two texels equally.
+        assert!((rep.eval(Vec2::new(0.0, 0.5))[0] - 0.5).abs() < 1e-6);
+        // Huge and NaN coordinates stay in range (no panic).
+        for u in [1e30f32, -1e30, f32::NAN, f32::INFINITY] {
+            let _ = rep.eval(Vec2::new(u, u));
+            let _ = cla.eval(Vec2::new(u, u));
+        }
+    }
+
+    /// A one-colour image is bit for bit `Rgb(...)`'s reflectance everywhere.
+    #[test]
+    fn a_one_colour_image_is_rgb_reflectance() {
+        let c = [0.7f32, 0.2, 0.1];
+        let want = crate::color::rgb_reflectance(c);
+        let t = image(5, 3, &[c; 15], Wrap::Repeat);
+        for (u, v) in [(0.0f32, 0.0f32), (0.13, 0.77), (0.5, 0.5), (0.99, 0.01), (-3.2, 8.1)] {
+            assert_eq!(t.eval(Vec2::new(u, v)), want);
+        }
+    }
+
+    /// The checkerboard's squares.
+    #[test]
+    fn checkerboard_squares() {
+        let t = Texture::Checkerboard { even: Spectrum::splat(0.8), odd: Spectrum::splat(0.1), scale: 4.0 };
+        assert_eq!(t.eval(Vec2::new(0.1, 0.1))[0], 0.8);
+        assert_eq!(t.eval(Vec2::new(0.3, 0.1))[0], 0.1);
+        assert_eq!(t.eval(Vec2::new(0.3, 0.3))[0], 0.8);
+        assert_eq!(t.eval(Vec2::new(-0.1, 0.1))[0], 0.1);
+    }
+}
