@@ -28,6 +28,7 @@ mod disk;
 mod distant;
 mod emit;
 mod point;
+pub mod sky;
 mod sphere;
 mod spot;
 
