@@ -18,9 +18,11 @@ a lookup of the solar pieces written afresh. Prints Rust table rows:
   theta 60 deg, 30 deg of azimuth from the sun.
 - SKY_BINS: the same at the renderer's 36 bins (380..730 nm), linear in
   wavelength between channels, 720 nm held at 730 nm, for a few cases.
-- SUN: (turbidity, sun elevation, [36 bins]) the sun's spectral irradiance on
-  a surface facing the zenith, E = integral over the disk of L_sun cos(theta)
-  d(omega), by Gauss-Legendre x trapezoid quadrature over the disk; and SUN_POINT:
+- SUN: (turbidity, sun elevation, [36 bins], [36 bins]) the sun's spectral
+  irradiance on a surface facing the zenith, E = integral over the disk of
+  L_sun cos(theta) d(omega), and on a surface facing the sun (cos(gamma) in
+  place of cos(theta)), by Gauss-Legendre x trapezoid quadrature over the disk;
+  and SUN_POINT:
   the sun's radiance at a few points of the disk.
 
 Every angle is printed with 9 significant digits and evaluated at the printed
@@ -155,8 +157,9 @@ def gauss_legendre(n):
     return nodes, weights
 
 
-def sun_irradiance(sky, lams, n_alpha=48, n_phi=96):
-    """E(lam) = integral over the disk of L_sun cos(theta) d(omega), on the horizontal.
+def sun_irradiance(sky, lams, normal, n_alpha=48, n_phi=96):
+    """E(lam) = integral over the disk of L_sun cos(theta) d(omega), on the horizontal;
+    or of L_sun cos(gamma) d(omega) on a surface facing the sun if `normal`.
 
     Around the sun's direction: gamma from sin(gamma) = sin(R) sin(alpha), alpha in [0, pi/2]
     (so the limb cosine is cos(alpha), smooth), d(omega) = tan(gamma) sin(R) cos(alpha) d(alpha) d(phi).
@@ -177,7 +180,7 @@ def sun_irradiance(sky, lams, n_alpha=48, n_phi=96):
                 continue
             dw = w_alpha * (2 * math.pi / n_phi) * jac
             for i, lam in enumerate(lams):
-                total[i] += sky.sun(lam, theta, gamma) * cos_t * dw
+                total[i] += sky.sun(lam, theta, gamma) * (math.cos(gamma) if normal else cos_t) * dw
     return total
 
 
@@ -211,12 +214,13 @@ def main():
         sky = Sky(arrays, turbidity, albedo, elevation)
         ch = [sky.channel(k, theta, gamma) for k in range(11)]
         print(f"({turbidity}, {albedo}, {elevation!r}, {theta!r}, {gamma!r}, [{fmt(sky.at_nm(l, ch) for l in bins)}]),")
-    print("// SUN: (turbidity, sun elevation, [horizontal irradiance at 380, 390, ..., 730 nm])")
+    print("// SUN: (turbidity, sun elevation, [irradiance at 380, 390, ..., 730 nm: horizontal], [facing the sun])")
     for turbidity in (2.0, 5.0, 9.0):
         for elev_deg in (5.0, 30.0, 60.0):
             elevation = g9(math.radians(elev_deg))
             sky = Sky(arrays, turbidity, 0.0, elevation)
-            print(f"({turbidity}, {elevation!r}, [{fmt(sun_irradiance(sky, bins))}]),")
+            horizontal, normal = sun_irradiance(sky, bins, False), sun_irradiance(sky, bins, True)
+            print(f"({turbidity}, {elevation!r}, [{fmt(horizontal)}], [{fmt(normal)}]),")
     print("// SUN_POINT: (turbidity, sun elevation, theta, gamma, [radiance at 380, 390, ..., 730 nm])")
     for turbidity, elev_deg, d_theta, gamma_frac in ((2.0, 30.0, 0.0, 0.0), (6.5, 10.0, 0.5, 0.5), (9.0, 60.0, -0.3, 0.95)):
         elevation = g9(math.radians(elev_deg))

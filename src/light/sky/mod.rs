@@ -48,11 +48,25 @@
 //! The sun's radiance is the direct part only; what the eye sees inside the
 //! disk is [`SkyModel::radiance`] + [`SkyModel::sun_radiance`].
 //!
+//! [`SkyModel::sun_irradiance`] is the disk's total, `∫ L_sun cos γ dω` on a
+//! surface facing the sun, integrated once in [`SkyModel::new`] (128 × 16
+//! points over the disk, midpoint in the limb angle, trapezoid around; the
+//! elevation's change across the disk matters at a low sun: taking the disk
+//! at its centre's elevation would be 1.5% off at 380 nm for a sun 5° high
+//! and turbidity 9).
+//!
 //! # Renderer bins
 //! [`SkyModel::radiance`] and [`SkyModel::sun_radiance`] return the renderer's
 //! 36 bins (380..730 nm): linear in wavelength between the channel centres
 //! (as the authors' code interpolates), and the 720 nm value held for 730 nm,
-//! beyond the model's range.
+//! beyond the model's range (the authors' code fades it linearly towards 0 at
+//! 760 nm instead; holding it keeps the last bin from darkening by a quarter
+//! for want of data).
+//!
+//! # Negative values
+//! The fitted sky function dips slightly below zero in places (down to about
+//! −1e-5 W m⁻² sr⁻¹ nm⁻¹ at 320 nm on the horizon 90° from a low sun, where the
+//! other channels are ~1e-2); every value returned here is clamped at 0.
 //!
 //! # Below the horizon
 //! The model is fitted for the upper hemisphere only (`θ ≤ π/2`; `√cos θ` is
@@ -111,20 +125,22 @@ const SOLAR_ORDER: usize = 4;
 /// elevation (see the module docs).
 #[derive(Clone, Debug)]
 pub struct SkyModel {
-    /// Per channel, the Perez parameters A B C D E F G I (as stored) and, in
-    /// place of H, nothing: the Mie term uses `mie` below.
+    /// Per channel, the Perez parameters A B C D E F G I (the data's order);
+    /// H enters only through `mie`.
     params: [[f32; 8]; N_CHANNELS],
     /// Per channel, `((1 − H)², 4H)` for the Mie term's denominator.
     mie: [[f32; 2]; N_CHANNELS],
     /// Per channel, the radiance scale `L_M` (W m⁻² sr⁻¹ nm⁻¹).
     scale: [f32; N_CHANNELS],
-    /// Lower integer turbidity index (0-based, 0..=8) for the solar data and
-    /// the weight of the next one.
-    solar_turbidity: (usize, f64),
+    /// Per channel and elevation piece, the sun's unlimbed radiance cubic
+    /// (highest power first) already interpolated to the turbidity.
+    solar: Box<[[[f32; SOLAR_ORDER]; SOLAR_PIECES]; N_CHANNELS]>,
     /// Per renderer bin, the limb-darkening coefficients interpolated to its wavelength.
     limb: [[f32; 6]; N_BINS],
     /// The sun's elevation in radians, as given.
     sun_elevation: f32,
+    /// The sun's irradiance on a surface facing it (see [`SkyModel::sun_irradiance`]).
+    sun_irradiance: Spectrum,
 }
 
 impl SkyModel {
@@ -184,13 +200,21 @@ impl SkyModel {
             scale[c] = l as f32;
         }
         // The solar data's turbidity index is 0-based; 10 is the top of 9..10.
-        let solar_turbidity = if t >= 10.0 { (8, 1.0) } else { (t_low - 1, t_frac) };
+        let (tl, tf) = if t >= 10.0 { (8, 1.0) } else { (t_low - 1, t_frac) };
+        let solar = Box::new(core::array::from_fn(|c| {
+            core::array::from_fn(|piece| {
+                let at = |turb: usize, k: usize| data::SOLAR[c][SOLAR_ORDER * (SOLAR_PIECES * turb + piece) + k];
+                core::array::from_fn(|k| ((1.0 - tf) * at(tl, k) + tf * at(tl + 1, k)) as f32)
+            })
+        }));
         let limb = core::array::from_fn(|i| {
             let (lo, w) = BIN_CHANNELS[i];
             let (w, c0, c1) = (f64::from(w), &data::LIMB_DARKENING[lo], &data::LIMB_DARKENING[lo + 1]);
             core::array::from_fn(|k| ((1.0 - w) * c0[k] + w * c1[k]) as f32)
         });
-        Ok(SkyModel { params, mie, scale, solar_turbidity, limb, sun_elevation })
+        let mut sky = SkyModel { params, mie, scale, solar, limb, sun_elevation, sun_irradiance: Spectrum::ZERO };
+        sky.sun_irradiance = sky.integrate_sun();
+        Ok(sky)
     }
 
     /// The sun's elevation in radians, as given to [`SkyModel::new`].
@@ -239,20 +263,56 @@ impl SkyModel {
         if theta.is_nan() || gamma.is_nan() || theta > FRAC_PI_2 || gamma > Self::SUN_ANGULAR_RADIUS {
             return Spectrum::ZERO;
         }
-        let elevation = (core::f64::consts::FRAC_PI_2 - f64::from(theta)).max(0.0);
-        let (tl, tf) = self.solar_turbidity;
-        let direct: [f64; N_CHANNELS] = core::array::from_fn(|c| {
-            (1.0 - tf) * solar_cubic(tl, c, elevation) + tf * solar_cubic(tl + 1, c, elevation)
+        let (piece, x) = solar_piece(theta);
+        let direct: [f32; N_CHANNELS] = core::array::from_fn(|c| {
+            let k = &self.solar[c][piece];
+            ((k[0] * x + k[1]) * x + k[2]) * x + k[3]
         });
         let ratio = gamma.sin() / Self::SUN_ANGULAR_RADIUS.sin();
         let mu = (1.0 - ratio * ratio).max(0.0).sqrt();
         Spectrum::from_fn(|i| {
             let (lo, t) = BIN_CHANNELS[i];
-            let l = ((1.0 - f64::from(t)) * direct[lo] + f64::from(t) * direct[lo + 1]) as f32;
+            let l = (1.0 - t) * direct[lo] + t * direct[lo + 1];
             let c = &self.limb[i];
             let darkening = c[0] + mu * (c[1] + mu * (c[2] + mu * (c[3] + mu * (c[4] + mu * c[5]))));
             (l * darkening).max(0.0)
         })
+    }
+
+    /// The sun's spectral irradiance (W m⁻² nm⁻¹) at the 36 bins on a surface
+    /// facing the sun, `∫ L_sun cos γ dω` over the disk, as computed by
+    /// [`SkyModel::new`] (see the module docs): what a light standing in for
+    /// the disk emits, or its weight among lights. The part of the disk below
+    /// the horizon (a sun lower than [`SkyModel::SUN_ANGULAR_RADIUS`]) counts 0.
+    pub fn sun_irradiance(&self) -> Spectrum {
+        self.sun_irradiance
+    }
+
+    /// [`SkyModel::sun_irradiance`] by quadrature of
+    /// [`SkyModel::sun_radiance`] over the disk: around the sun's direction,
+    /// `sin γ = sin R sin α` (so the limb cosine is `cos α` and the integrand
+    /// is smooth), `dω = tan γ sin R cos α dα dφ`, midpoint rule in `α` and `φ`.
+    fn integrate_sun(&self) -> Spectrum {
+        const N_ALPHA: usize = 128;
+        const N_PHI: usize = 16;
+        let r = f64::from(Self::SUN_ANGULAR_RADIUS);
+        let theta_s = core::f64::consts::FRAC_PI_2 - f64::from(self.sun_elevation);
+        let (d_alpha, d_phi) = (core::f64::consts::FRAC_PI_2 / N_ALPHA as f64, core::f64::consts::TAU / N_PHI as f64);
+        let mut e = [0.0f64; N_BINS];
+        for ia in 0..N_ALPHA {
+            let alpha = (ia as f64 + 0.5) * d_alpha;
+            let gamma = (r.sin() * alpha.sin()).asin();
+            let weight = gamma.tan() * r.sin() * alpha.cos() * gamma.cos() * d_alpha * d_phi;
+            for ip in 0..N_PHI {
+                let phi = (ip as f64 + 0.5) * d_phi;
+                let cos_theta = theta_s.cos() * gamma.cos() + theta_s.sin() * gamma.sin() * phi.cos();
+                let l = self.sun_radiance(cos_theta.clamp(-1.0, 1.0).acos() as f32, gamma as f32);
+                for (ei, li) in e.iter_mut().zip(l.0) {
+                    *ei += f64::from(li) * weight;
+                }
+            }
+        }
+        Spectrum::from_fn(|i| e[i] as f32)
     }
 }
 
@@ -270,14 +330,14 @@ fn bernstein5(x: f64) -> [f64; 6] {
     [y.powi(5), 5.0 * y.powi(4) * x, 10.0 * y.powi(3) * x * x, 10.0 * y * y * x.powi(3), 5.0 * y * x.powi(4), x.powi(5)]
 }
 
-/// The unlimbed solar radiance of channel `c` at the 0-based integer
-/// turbidity index `turbidity` for a direction at `elevation` (radians, ≥ 0).
-fn solar_cubic(turbidity: usize, c: usize, elevation: f64) -> f64 {
+/// The solar function's elevation piece for a direction at zenith angle
+/// `theta` (elevation `π/2 − theta`, clamped at 0): the pieces start at
+/// elevations `(k/45)³ π/2`, `k = 0..45`; and the elevation above the piece's
+/// start, the cubic's variable.
+fn solar_piece(theta: f32) -> (usize, f32) {
+    let elevation = (core::f64::consts::FRAC_PI_2 - f64::from(theta)).max(0.0);
     let u = (elevation / core::f64::consts::FRAC_PI_2).cbrt();
     let piece = ((u * SOLAR_PIECES as f64) as usize).min(SOLAR_PIECES - 1);
     let start = (piece as f64 / SOLAR_PIECES as f64).powi(3) * core::f64::consts::FRAC_PI_2;
-    let base = SOLAR_ORDER * (SOLAR_PIECES * turbidity + piece);
-    let k = &data::SOLAR[c][base..base + SOLAR_ORDER];
-    let x = elevation - start;
-    ((k[0] * x + k[1]) * x + k[2]) * x + k[3]
+    (piece, (elevation - start) as f32)
 }

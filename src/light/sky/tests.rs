@@ -125,7 +125,7 @@ fn sun_irradiance(sky: &SkyModel, n_alpha: usize, n_phi: usize) -> [f64; N_BINS]
 fn sun_irradiance_matches_the_python_quadrature_and_the_closed_form() {
     let r = f64::from(SkyModel::SUN_ANGULAR_RADIUS);
     let (mut worst_py, mut worst_closed) = (0.0f64, 0.0f64);
-    for &(t, e, want) in &reference::SUN {
+    for &(t, e, want, _) in &reference::SUN {
         let sky = model(t, 0.0, e);
         let got = sun_irradiance(&sky, 200, 128);
         for i in 0..N_BINS {
@@ -156,11 +156,28 @@ fn sun_irradiance_matches_the_python_quadrature_and_the_closed_form() {
             assert!(err <= 1e-3, "T {t} elevation {e} {nm} nm: quadrature {} vs closed form {closed}", got[i]);
         }
     }
-    let (t, e, want) = reference::SUN[7]; // T 9, 30°
+    // The irradiance facing the sun that `new` integrates, against Python's.
+    let mut worst_api = 0.0f64;
+    for &(t, e, _, want) in &reference::SUN {
+        let normal = model(t, 0.0, e).sun_irradiance();
+        for i in 0..N_BINS {
+            let err = (f64::from(normal[i]) - want[i]).abs() / want[i];
+            worst_api = worst_api.max(err);
+            assert!(
+                err <= 2e-4,
+                "T {t} elevation {e} {} nm: sun_irradiance {} vs {}",
+                bin_lambda_nm(i),
+                normal[i],
+                want[i]
+            );
+        }
+    }
+    let (t, e, want, normal) = reference::SUN[7]; // T 9, 30°
     println!(
         "sun irradiance: largest relative error {worst_py:.2e} vs Python, {worst_closed:.2e} vs the closed form; \
-         T {t}, elevation {e}: E(550 nm) = {:.4} W m^-2 nm^-1 on the horizontal",
-        want[17]
+         sun_irradiance(): {worst_api:.2e} vs Python; T {t}, elevation {e}: E(550 nm) = {:.4} W m^-2 nm^-1 on the \
+         horizontal, {:.4} facing the sun",
+        want[17], normal[17]
     );
 }
 
@@ -287,6 +304,16 @@ fn cost_of_one_radiance_call() {
         acc += l[17];
     }
     let sun_per_call = start.elapsed().as_secs_f64() / n as f64;
-    println!("radiance(): {:.0} ns per call; sun_radiance(): {:.0} ns per call", per_call * 1e9, sun_per_call * 1e9);
+    let start = std::time::Instant::now();
+    for k in 0..100 {
+        acc += SkyModel::new(std::hint::black_box(1.0 + 0.09 * k as f32), 0.3, 0.4).unwrap().sun_irradiance()[17];
+    }
+    let new_per_call = start.elapsed().as_secs_f64() / 100.0;
+    println!(
+        "radiance(): {:.0} ns per call; sun_radiance(): {:.0} ns per call; new(): {:.0} µs",
+        per_call * 1e9,
+        sun_per_call * 1e9,
+        new_per_call * 1e6
+    );
     assert!(acc.is_finite() && acc > 0.0);
 }
