@@ -225,7 +225,8 @@ impl SkyModel {
     /// Sky radiance (W m⁻² sr⁻¹ nm⁻¹) at the 11 channels ([`CHANNEL_NM`])
     /// towards a direction at zenith angle `theta` (radians) and angle `gamma`
     /// to the sun's centre. Zero below the horizon (`theta > π/2`) and for NaN;
-    /// never negative.
+    /// never negative. Near the sun, `gamma` from `atan2(|d × s|, d · s)` (view
+    /// and sun directions) keeps the precision that `acos(d · s)` loses in `f32`.
     pub fn channels(&self, theta: f32, gamma: f32) -> [f32; N_CHANNELS] {
         if theta.is_nan() || gamma.is_nan() || theta > FRAC_PI_2 {
             return [0.0; N_CHANNELS];
