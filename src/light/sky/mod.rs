@@ -25,7 +25,8 @@
 //! a radiance evaluation is then three `exp`/`sqrt`-class calls per channel.
 //! The Mie term's denominator is evaluated as `(1 − H)² + 4H sin²(γ/2)`, the
 //! same quantity without the cancellation of `1 + H² − 2H cos γ` in `f32`
-//! near the sun (`H` is close to 1).
+//! near the sun (`H` is 0.5 to 0.9, so `(1 − H)²` can be 100 times smaller
+//! than the terms it is the difference of).
 //!
 //! Units: W m⁻² sr⁻¹ nm⁻¹ (absolute spectral radiance; the model's output
 //! since its version 1.1).
@@ -41,10 +42,11 @@
 //! redder and dimmer, which is why [`SkyModel::sun_radiance`] takes `θ` as
 //! well as `γ` (a change from the single-argument interface first planned).
 //!
-//! [`SkyModel::SUN_ANGULAR_RADIUS`] is the model's 0.255° (half of the 0.51°
-//! diameter the authors fitted with, their `TERRESTRIAL_SOLAR_RADIUS`), not
-//! the astronomical mean 0.2666°: the solar coefficients are radiances for
-//! that disk, and a larger disk would add about 9% to the sun's irradiance.
+//! [`SkyModel::SUN_ANGULAR_RADIUS`] is the model's 0.255°: the radius of the
+//! terrestrial sun in the authors' implementation (`TERRESTRIAL_SOLAR_RADIUS`,
+//! half of 0.51°), which the limb darkening's `sin R` and the solar
+//! coefficients go with; not the astronomical mean 0.2666°, which with the
+//! same radiance would add about 9% to the sun's irradiance.
 //! The sun's radiance is the direct part only; what the eye sees inside the
 //! disk is [`SkyModel::radiance`] + [`SkyModel::sun_radiance`].
 //!
