@@ -29,6 +29,7 @@ mod distant;
 mod emit;
 mod environment;
 mod point;
+pub mod sky;
 mod sphere;
 mod spot;
 
