@@ -72,6 +72,32 @@ pub enum EnvironmentDesc {
         #[serde(default)]
         rotate_deg: V3,
     },
+    /// The spectral Hosek-Wilkie sky with its sun, in absolute units
+    /// (W m⁻² sr⁻¹ nm⁻¹): `Sky(sun_elevation_deg: 20, sun_azimuth_deg: 30, turbidity: 3, ground_albedo: 0.3)`.
+    Sky {
+        /// The sun's height above the horizon, degrees in [0, 90].
+        sun_elevation_deg: f32,
+        /// The sun's direction about +y, degrees: 0 towards −z, 90 towards +x (default 0).
+        #[serde(default)]
+        sun_azimuth_deg: f32,
+        /// Atmospheric turbidity in [1, 10] (default 3: a clear day).
+        #[serde(default = "default_turbidity")]
+        turbidity: f32,
+        /// The ground's reflectance in [0, 1] (default 0.3).
+        #[serde(default = "default_ground_albedo")]
+        ground_albedo: f32,
+        /// A factor on the sky, sun and ground (default 1).
+        #[serde(default = "one")]
+        scale: f32,
+    },
+}
+
+fn default_turbidity() -> f32 {
+    3.0
+}
+
+fn default_ground_albedo() -> f32 {
+    0.3
 }
 
 fn one() -> f32 {

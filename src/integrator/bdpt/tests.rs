@@ -71,6 +71,7 @@ fn walk(scene: &Scene, path: &mut Vec<Vertex>, mut pdf_dir: f32, points: &[Point
             pdf_rev: 0.0,
             g_prev: 0.0,
             outside: None,
+            uv: glam::Vec2::ZERO,
         };
         v.pdf_fwd = to_area(scene, pdf_dir, &prev, &v);
         v.g_prev = to_area(scene, 1.0, &v, &prev);
