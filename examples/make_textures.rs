@@ -1,0 +1,81 @@
+//! Writes the small images the shipped scenes use, deterministically:
+//!
+//! - `scenes/textures/outdoor.exr`: a 128x64 equirectangular environment
+//!   (linear sRGB, +y up, u = 0 towards −z; see `crate::light::EnvironmentLight`):
+//!   a blue sky graded to a pale horizon, a warm sun 5x5 texels wide at 35°
+//!   elevation towards +x, a bright overcast panel towards +z, and a
+//!   brown-grey ground.
+//! - `scenes/textures/chart.png`: a 96x64 8-bit sRGB chart of 6x4 coloured
+//!   patches (the ColorChecker's order, approximate sRGB values) on a black grid.
+//!
+//! Run: `cargo run --release --example make_textures` (from the repository root).
+
+use std::f32::consts::PI;
+
+fn main() {
+    let (w, h) = (128u32, 64u32);
+    let mut px = Vec::with_capacity((w * h * 3) as usize);
+    for j in 0..h {
+        for i in 0..w {
+            let (u, v) = ((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+            let (theta, phi) = (PI * v, 2.0 * PI * u);
+            let d = [theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos()];
+            let rgb = if d[1] >= 0.0 {
+                let t = d[1].powf(0.4);
+                let mut c = [0.75 - 0.45 * t, 0.85 - 0.35 * t, 1.0 - 0.1 * t];
+                // The sun: towards +x, 35° up; 5x5 texels of about 200x the sky.
+                let sun = [35f32.to_radians().cos(), 35f32.to_radians().sin(), 0.0];
+                let cos = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
+                if cos > (5.0f32 * PI / 64.0 / 2.0).cos() {
+                    c = [220.0, 190.0, 150.0];
+                }
+                // A soft bright panel towards +z, low in the sky.
+                if d[2] > 0.9 && d[1] < 0.35 {
+                    c = c.map(|x| x * 4.0);
+                }
+                c
+            } else {
+                [0.22, 0.18, 0.14]
+            };
+            px.extend_from_slice(&rgb);
+        }
+    }
+    image::Rgb32FImage::from_raw(w, h, px).unwrap().save("scenes/textures/outdoor.exr").unwrap();
+
+    // Approximate sRGB (8-bit) of the 24 ColorChecker patches, row by row.
+    const PATCHES: [[u8; 3]; 24] = [
+        [115, 82, 68],
+        [194, 150, 130],
+        [98, 122, 157],
+        [87, 108, 67],
+        [133, 128, 177],
+        [103, 189, 170],
+        [214, 126, 44],
+        [80, 91, 166],
+        [193, 90, 99],
+        [94, 60, 108],
+        [157, 188, 64],
+        [224, 163, 46],
+        [56, 61, 150],
+        [70, 148, 73],
+        [175, 54, 60],
+        [231, 199, 31],
+        [187, 86, 149],
+        [8, 133, 161],
+        [243, 243, 242],
+        [200, 200, 200],
+        [160, 160, 160],
+        [122, 122, 121],
+        [85, 85, 85],
+        [52, 52, 52],
+    ];
+    let (cw, ch) = (96u32, 64u32);
+    let img = image::RgbImage::from_fn(cw, ch, |x, y| {
+        let (px, py) = (x % 16, y % 16);
+        if px < 2 || py < 2 {
+            return image::Rgb([20, 20, 20]);
+        }
+        image::Rgb(PATCHES[((y / 16) * 6 + x / 16) as usize])
+    });
+    img.save("scenes/textures/chart.png").unwrap();
+}
