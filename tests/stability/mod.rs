@@ -11,6 +11,7 @@ use rust_v::film::Film;
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 mod bias;
+mod environment;
 mod glass;
 mod lighttrace;
 mod materials;
