@@ -369,7 +369,8 @@ pub(crate) fn sample_direct<const N: usize>(
     } else {
         power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, outside))
     };
-    f * lambdas.sample(&scene.light(choice.light).radiance(ls.wi)) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+    let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
+    f * le * (ls.scale * wi_local.z.abs() * weight / pdf_light)
 }
 
 #[cfg(test)]

@@ -182,7 +182,8 @@ impl PathTracer {
             if w.bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = &*scene.bsdf_at(&si);
+            let mut textured = None;
+            let bxdf = scene.bsdf_in(&si, &mut textured);
             if bxdf.is_black() {
                 break;
             }

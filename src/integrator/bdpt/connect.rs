@@ -59,7 +59,8 @@ impl Bdpt {
                 if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
             }
             Kind::Surface(o) => {
-                let bxdf = bsdf_at(scene, o, qs);
+                let mut slot = None;
+                let bxdf = bsdf_at(scene, o, qs, &mut slot);
                 let wi = qs.sh.frame.to_local(w);
                 if !qs.sh.consistent(w, wi) {
                     return None;
@@ -155,20 +156,22 @@ impl Bdpt {
                     return NONE;
                 };
                 let light = scene.light(index);
-                let radiance = light.radiance(ls.wi);
                 let wi = pt.sh.frame.to_local(ls.wi);
                 if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
                 }
-                let bxdf = bsdf_at(scene, object, pt);
+                let mut slot = None;
+                let bxdf = bsdf_at(scene, object, pt, &mut slot);
                 let out = outside(scene, pt.outside);
                 let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
                     let f = bxdf.eval_within(pt.sh.wo, wi, &one.lambdas, out)[0];
-                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(&radiance)[0] * k)
+                    let le = light.with_radiance(ls.wi, |s| one.lambdas.sample(s)[0]);
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * le * k)
                 } else {
-                    Contrib::Full(pt.beta * bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out) * *radiance * k)
+                    let f = bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out);
+                    light.with_radiance(ls.wi, |s| Contrib::Full(pt.beta * f * *s * k))
                 };
                 if is_black(&c) {
                     return NONE;
@@ -207,7 +210,8 @@ impl Bdpt {
                 if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
                     return NONE;
                 }
-                let (bp, bq) = (bsdf_at(scene, object, pt), bsdf_at(scene, q_object, qs));
+                let (mut slot_p, mut slot_q) = (None, None);
+                let (bp, bq) = (bsdf_at(scene, object, pt, &mut slot_p), bsdf_at(scene, q_object, qs, &mut slot_q));
                 let (op, oq) = (outside(scene, pt.outside), outside(scene, qs.outside));
                 let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
                 let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {
@@ -253,12 +257,11 @@ impl Bdpt {
         let (pt, ptm) = (&camera.v[t - 1], &camera.v[t - 2]);
         let light = scene.light(index);
         let dir = (pt.p() - ptm.p()).normalize();
-        let le = light.radiance(dir);
         let c = if pt.collapsed {
             let one = wl.single();
-            Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(&le)[0])
+            Contrib::Single(pt.beta[one.slot] * light.with_radiance(dir, |s| one.lambdas.sample(s)[0]))
         } else {
-            Contrib::Full(pt.beta * *le)
+            Contrib::Full(light.with_radiance(dir, |s| pt.beta * *s))
         };
         if t == 2 {
             return c;

@@ -1,7 +1,6 @@
 //! Subpath vertices, the sample's collapsed wavelength, and the densities and
 //! material queries a vertex answers.
 
-use std::borrow::Cow;
 use std::sync::LazyLock;
 
 use glam::{Vec2, Vec3};
@@ -166,10 +165,11 @@ pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
     scene.bsdf(o)
 }
 
-/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the vertex's (u, v)).
-#[inline]
-pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex) -> Cow<'s, Bxdf> {
-    scene.bsdf_uv(o, v.uv)
+/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the
+/// vertex's (u, v), built in `slot`).
+#[inline(always)]
+pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex, slot: &'s mut Option<Bxdf>) -> &'s Bxdf {
+    scene.bsdf_uv(o, v.uv, slot)
 }
 
 /// True when a connection can end at `v`: a surface whose material has a
@@ -222,7 +222,10 @@ pub(super) fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -
 #[inline]
 pub(super) fn pdf_at(scene: &Scene, v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
     match v.kind {
-        Kind::Surface(o) => bsdf_at(scene, o, v).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside)),
+        Kind::Surface(o) => {
+            let mut slot = None;
+            bsdf_at(scene, o, v, &mut slot).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside))
+        }
         _ => 0.0,
     }
 }

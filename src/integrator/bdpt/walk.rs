@@ -66,7 +66,8 @@ impl Walk {
             let hit = si.hit;
             let textured = scene.texture(si.object).is_some();
             let uv = if textured { scene.uv(&si) } else { glam::Vec2::ZERO };
-            let bxdf = scene.bsdf_uv(si.object, uv);
+            let mut slot = None;
+            let bxdf = scene.bsdf_uv(si.object, uv, &mut slot);
             // Beer-Lambert along the segment, in the medium it ran in.
             if let Some(medium) = scene.medium_in(media.current()) {
                 if collapsed {
