@@ -106,7 +106,7 @@ pub(crate) struct FullSpectrum(pub Transport);
 impl Estimator for FullSpectrum {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
-        let ray = scene.camera.ray(film);
+        let ray = camera_ray(scene, film, sampler);
         self.0.li(scene, ray, &Lambdas::full(), sampler)
     }
 }
@@ -119,7 +119,7 @@ pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling,
 impl<const C: usize> Estimator for Packets<C> {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
-        let ray = scene.camera.ray(film);
+        let ray = camera_ray(scene, film, sampler);
         let u: [f32; C] = std::array::from_fn(|i| sampler.get_1d(Dim::wavelength(i)));
         let lambdas = if O::CONTINUOUS && (self.2 || scene.has_dispersion()) {
             sample_packet_continuous::<C>(self.1, u)
@@ -136,9 +136,17 @@ pub(crate) struct RgbWavelengths(pub Transport);
 impl Estimator for RgbWavelengths {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
-        let ray = scene.camera.ray(film);
+        let ray = camera_ray(scene, film, sampler);
         self.0.li(scene, ray, &Lambdas::rgb(), sampler)
     }
+}
+
+/// The camera ray through film position `film`: with a thin lens, through
+/// the lens point of a [`Dim::LENS`] draw; a pinhole draws nothing.
+#[inline]
+pub(crate) fn camera_ray(scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Ray {
+    let cam = &scene.camera;
+    if cam.has_lens() { cam.ray_through(film, sampler.get_2d(Dim::LENS)) } else { cam.ray(film) }
 }
 
 /// Calls `f` with the estimator the settings ask for: the one place where the

@@ -79,7 +79,7 @@ impl<'de> Deserialize<'de> for Materials {
     }
 }
 
-/// A pinhole camera.
+/// A pinhole camera, or a thin lens with depth of field.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
@@ -92,6 +92,13 @@ pub struct CameraDesc {
     pub up: V3,
     /// Vertical field of view in degrees.
     pub fov_deg: f32,
+    /// The thin lens's radius in scene units (default 0: a pinhole, no depth of field).
+    #[serde(default)]
+    pub aperture_radius: f32,
+    /// The distance of the plane in focus along the view direction (default:
+    /// from `eye` to `look_at`).
+    #[serde(default)]
+    pub focus_distance: Option<f32>,
 }
 
 fn default_up() -> V3 {

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::check::{Check, Input};
+use super::check::{Check, Input, MAX_MAGNITUDE};
 use super::desc::{SceneDesc, ShapeDesc};
 use super::{Object, Scene};
 use crate::bxdf::Bxdf;
@@ -233,7 +233,18 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
         return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {}", c.fov_deg)));
     }
-    let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height);
+    if !(c.aperture_radius >= 0.0 && c.aperture_radius <= MAX_MAGNITUDE) {
+        return Err(ctx.err(
+            "camera.aperture_radius",
+            format!("expected a radius from 0 (a pinhole) up to {MAX_MAGNITUDE:e}, found {}", c.aperture_radius),
+        ));
+    }
+    let focus = match c.focus_distance {
+        Some(f) => ctx.positive("camera.focus_distance", f)?,
+        None => (look_at - eye).length(),
+    };
+    let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height)
+        .with_thin_lens(c.aperture_radius, focus);
     Ok(Scene::new(objects, materials, lights, camera, settings, 0))
 }
 
