@@ -19,6 +19,7 @@
 //! camera: (eye: (0, 1, 3.5), look_at: (0, 1, 0), up: (0, 1, 0), fov_deg: 45),
 //! ```
 
+pub mod lens_system;
 mod thin_lens;
 
 pub use thin_lens::ThinLens;

@@ -1,0 +1,369 @@
+//! Lens systems: a real lens prescription in pbrt's lens-file format, traced
+//! surface by surface (pbrt-v4's `RealisticCamera`, read, not copied), and
+//! its paraxial properties found by tracing rays near the axis.
+//!
+//! # The lens file
+//! One row per surface, from the scene side (front) to the film side (rear),
+//! four numbers separated by spaces or tabs, in millimetres; `#` starts a
+//! comment, blank lines are skipped:
+//!
+//! | column | meaning |
+//! |---|---|
+//! | radius | the surface's radius of curvature, positive when its centre lies on the film side; 0 for the aperture stop (a flat opening) |
+//! | thickness | the distance along the axis to the next surface (from the last: to the film, which focusing sets) |
+//! | index | the index of refraction of what follows the surface, towards the film (0 or 1: air) |
+//! | aperture | the surface's clear aperture, a diameter |
+//!
+//! ```text
+//! # radius  thickness  index  aperture
+//! 51.68     4          1.5168 25
+//! -51.68    0          1      25
+//! ```
+//!
+//! Every mistake is an error naming the file, the line and the column: a
+//! missing or extra column, a number that does not parse or is not finite, a
+//! negative or zero aperture, a negative thickness, an index below 1 (other
+//! than 0), a stop in glass, a surface whose radius is smaller than its
+//! aperture's, and two surfaces that cross inside their apertures.
+//!
+//! # Coordinates
+//! Lens space is right-handed with `z` along the optical axis, increasing
+//! from the scene towards the film; the front surface's vertex is at `z = 0`
+//! and surface `i`'s at the sum of the thicknesses before it. Lengths are in
+//! millimetres and computed in `f64` (paraxial properties need the precision).
+//!
+//! # Paraxial properties
+//! A ray parallel to the axis at a small height `h` from the scene leaves
+//! the last surface towards the rear focal point, where it crosses the axis;
+//! the rear principal plane is where the extension of the incoming ray meets
+//! the extension of the outgoing one. The effective focal length is the
+//! distance from that plane to the focal point, the back focal distance the
+//! distance from the last surface's vertex (pbrt-v4's thick-lens
+//! approximation, `ComputeCardinalPoints`, traces rays the same way).
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::error::{Error, Result};
+
+/// One surface of a lens system, in millimetres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LensSurface {
+    /// Radius of curvature (positive: centre on the film side); 0 for the aperture stop.
+    pub radius: f64,
+    /// Distance along the axis to the next surface (from the last: to the film).
+    pub thickness: f64,
+    /// Index of refraction of the medium after the surface, towards the film (1 for air).
+    pub index: f64,
+    /// Half the clear aperture.
+    pub aperture_radius: f64,
+}
+
+impl LensSurface {
+    /// True for the aperture stop (a flat opening, no refraction).
+    #[inline]
+    pub fn is_stop(&self) -> bool {
+        self.radius == 0.0
+    }
+}
+
+/// A lens system: its surfaces from the front (scene side) to the rear.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LensSystem {
+    /// The surfaces, front to rear.
+    pub surfaces: Vec<LensSurface>,
+}
+
+/// A ray in lens space (millimetres; `dir` need not be unit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LensRay {
+    /// The origin.
+    pub origin: DVec3,
+    /// The direction.
+    pub dir: DVec3,
+}
+
+/// The four columns of a row, for error messages.
+const COLUMNS: [&str; 4] = ["radius", "thickness", "index", "aperture"];
+
+impl LensSystem {
+    /// Reads the lens file at `path` (see the module doc for the format).
+    pub fn load(path: &Path) -> Result<LensSystem> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        LensSystem::parse(&text, path)
+    }
+
+    /// Parses a lens file's text; `path` names it in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<LensSystem> {
+        let err = |line: usize, col: usize, message: String| Error::Scene {
+            path: path.to_path_buf(),
+            position: Some((line, col)),
+            field: String::new(),
+            message,
+        };
+        let mut surfaces = Vec::new();
+        // Each surface's line and the column of its thickness, for the overlap check.
+        let mut rows: Vec<(usize, usize)> = Vec::new();
+        for (n, raw) in text.lines().enumerate() {
+            let line = n + 1;
+            let content = raw.split('#').next().unwrap_or("");
+            let mut fields = Vec::new();
+            let mut start = None;
+            for (i, c) in content.char_indices().chain(std::iter::once((content.len(), ' '))) {
+                match (c.is_whitespace(), start) {
+                    (false, None) => start = Some(i),
+                    (true, Some(s)) => {
+                        fields.push((content[..s].chars().count() + 1, &content[s..i]));
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+            if fields.is_empty() {
+                continue;
+            }
+            if fields.len() < 4 {
+                let col = content.trim_end().chars().count() + 1;
+                return Err(err(
+                    line,
+                    col,
+                    format!(
+                        "expected 4 columns (radius, thickness, index, aperture diameter in mm), found {}: the {} is missing",
+                        fields.len(),
+                        COLUMNS[fields.len()]
+                    ),
+                ));
+            }
+            if fields.len() > 4 {
+                return Err(err(
+                    line,
+                    fields[4].0,
+                    format!(
+                        "expected 4 columns (radius, thickness, index, aperture diameter in mm), found {}",
+                        fields.len()
+                    ),
+                ));
+            }
+            let mut v = [0.0f64; 4];
+            for (k, &(col, s)) in fields.iter().enumerate() {
+                v[k] = match s.parse::<f64>() {
+                    Ok(x) if x.is_finite() && x.abs() <= 1e9 => x,
+                    _ => {
+                        return Err(err(
+                            line,
+                            col,
+                            format!("the {}: expected a finite number of mm up to 1e9, found `{s}`", COLUMNS[k]),
+                        ));
+                    }
+                };
+            }
+            let [radius, thickness, index, aperture] = v;
+            let col = |k: usize| fields[k].0;
+            if thickness < 0.0 {
+                return Err(err(line, col(1), format!("the thickness must not be negative, found {thickness}")));
+            }
+            if !(index == 0.0 || index >= 1.0) {
+                return Err(err(line, col(2), format!("the index must be 1 or more (0 or 1: air), found {index}")));
+            }
+            if aperture <= 0.0 {
+                return Err(err(line, col(3), format!("the aperture diameter must be positive, found {aperture}")));
+            }
+            if radius == 0.0 && index > 1.0 {
+                return Err(err(
+                    line,
+                    col(2),
+                    format!("the aperture stop (radius 0) must be followed by air (index 0 or 1), found {index}"),
+                ));
+            }
+            if radius != 0.0 && radius.abs() < aperture / 2.0 {
+                return Err(err(
+                    line,
+                    col(0),
+                    format!("a sphere of radius {} cannot span the aperture diameter {aperture}", radius.abs()),
+                ));
+            }
+            surfaces.push(LensSurface {
+                radius,
+                thickness,
+                index: if index == 0.0 { 1.0 } else { index },
+                aperture_radius: aperture / 2.0,
+            });
+            rows.push((line, col(1)));
+        }
+        if surfaces.is_empty() {
+            return Err(err(1, 1, "expected at least one surface row (radius, thickness, index, aperture)".into()));
+        }
+        // Neighbouring surfaces must not cross inside their common aperture.
+        for i in 0..surfaces.len() - 1 {
+            let (a, b) = (surfaces[i], surfaces[i + 1]);
+            let h = a.aperture_radius.min(b.aperture_radius);
+            let gap = a.thickness + sag(b.radius, h) - sag(a.radius, h);
+            if gap < -1e-9 {
+                let (line, col) = rows[i];
+                return Err(err(
+                    line,
+                    col,
+                    format!(
+                        "this surface and the next (line {}) cross inside their apertures: {:.4} mm apart at the axis, {gap:.4} at height {h} mm",
+                        rows[i + 1].0,
+                        a.thickness
+                    ),
+                ));
+            }
+        }
+        Ok(LensSystem { surfaces })
+    }
+
+    /// The `z` of each surface's vertex (the front one at 0).
+    pub fn vertices(&self) -> Vec<f64> {
+        let mut z = 0.0;
+        self.surfaces
+            .iter()
+            .map(|s| {
+                let at = z;
+                z += s.thickness;
+                at
+            })
+            .collect()
+    }
+
+    /// Traces `ray` (from the scene side, going towards +z) through every
+    /// surface, front to rear. `None` when it misses a surface or the stop
+    /// inside its aperture, or is totally reflected. The ray returned starts
+    /// on the last surface, in the medium after it.
+    pub fn trace_from_scene(&self, ray: LensRay) -> Option<LensRay> {
+        let z = self.vertices();
+        let mut r = LensRay { origin: ray.origin, dir: ray.dir.normalize() };
+        let mut eta_before = 1.0;
+        for (s, &zv) in self.surfaces.iter().zip(&z) {
+            let (p, n) = intersect(s, zv, &r)?;
+            if p.x * p.x + p.y * p.y > s.aperture_radius * s.aperture_radius {
+                return None;
+            }
+            let dir = if s.is_stop() { r.dir } else { refract(r.dir, n, eta_before / s.index)? };
+            r = LensRay { origin: p, dir };
+            eta_before = s.index;
+        }
+        Some(r)
+    }
+
+    /// Traces `ray` (from the film side, going towards −z) through every
+    /// surface, rear to front; `None` as for [`LensSystem::trace_from_scene`].
+    /// The ray returned starts on the front surface, in air.
+    pub fn trace_from_film(&self, ray: LensRay) -> Option<LensRay> {
+        let z = self.vertices();
+        let mut r = LensRay { origin: ray.origin, dir: ray.dir.normalize() };
+        for i in (0..self.surfaces.len()).rev() {
+            let s = &self.surfaces[i];
+            let (p, n) = intersect(s, z[i], &r)?;
+            if p.x * p.x + p.y * p.y > s.aperture_radius * s.aperture_radius {
+                return None;
+            }
+            let eta_after = if i > 0 { self.surfaces[i - 1].index } else { 1.0 };
+            let dir = if s.is_stop() { r.dir } else { refract(r.dir, n, s.index / eta_after)? };
+            r = LensRay { origin: p, dir };
+        }
+        Some(r)
+    }
+
+    /// The rear cardinal points from a ray parallel to the axis at height
+    /// `h` (mm) from the scene: `(principal plane z, focal point z)`; `None`
+    /// if the ray does not pass or leaves parallel to the axis.
+    pub fn rear_cardinal_points(&self, h: f64) -> Option<(f64, f64)> {
+        let r = self.trace_from_scene(LensRay { origin: DVec3::new(h, 0.0, -1.0), dir: DVec3::Z })?;
+        // Where the outgoing ray crosses the axis, and where it is at height h.
+        if r.dir.x == 0.0 || r.dir.z <= 0.0 {
+            return None;
+        }
+        let focus = r.origin.z - r.origin.x * r.dir.z / r.dir.x;
+        let principal = r.origin.z + (h - r.origin.x) * r.dir.z / r.dir.x;
+        Some((principal, focus))
+    }
+
+    /// The paraxial effective focal length (mm): from the rear principal
+    /// plane to the rear focal point, by a ray at a small height (10⁻⁴ of
+    /// the front aperture's radius, where the exact trace is paraxial to
+    /// about 10⁻⁸).
+    pub fn effective_focal_length(&self) -> Option<f64> {
+        let (principal, focus) = self.rear_cardinal_points(self.paraxial_height())?;
+        Some(focus - principal)
+    }
+
+    /// The paraxial back focal distance (mm): from the last surface's vertex
+    /// to the rear focal point (see [`LensSystem::effective_focal_length`]).
+    pub fn back_focal_distance(&self) -> Option<f64> {
+        let (_, focus) = self.rear_cardinal_points(self.paraxial_height())?;
+        let last = *self.vertices().last()?;
+        Some(focus - last)
+    }
+
+    fn paraxial_height(&self) -> f64 {
+        self.surfaces[0].aperture_radius * 1e-4
+    }
+}
+
+/// The sag of a spherical surface of radius `r` (0: flat) at height `h`: how
+/// far its point at that height lies from its vertex along +z.
+fn sag(r: f64, h: f64) -> f64 {
+    if r == 0.0 {
+        return 0.0;
+    }
+    r - r.signum() * (r * r - h * h).max(0.0).sqrt()
+}
+
+/// The ray's hit on surface `s` whose vertex is at `z`, and the surface's
+/// unit normal there facing the ray (against its direction).
+fn intersect(s: &LensSurface, z: f64, r: &LensRay) -> Option<(DVec3, DVec3)> {
+    if s.is_stop() {
+        if r.dir.z == 0.0 {
+            return None;
+        }
+        let t = (z - r.origin.z) / r.dir.z;
+        if t <= 0.0 {
+            return None;
+        }
+        return Some((r.origin + r.dir * t, DVec3::new(0.0, 0.0, -r.dir.z.signum())));
+    }
+    let centre = DVec3::new(0.0, 0.0, z + s.radius);
+    let o = r.origin - centre;
+    let (a, b, c) = (r.dir.length_squared(), 2.0 * r.dir.dot(o), o.length_squared() - s.radius * s.radius);
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    // A numerically stable pair of roots.
+    let q = if b < 0.0 { -0.5 * (b - root) } else { -0.5 * (b + root) };
+    let (t0, t1) = (q / a, c / q);
+    let (t0, t1) = (t0.min(t1), t0.max(t1));
+    // The vertex's side of the sphere: the nearer hit when the ray travels
+    // towards the centre from the vertex's side, else the farther.
+    let towards_centre = (r.dir.z > 0.0) == (s.radius > 0.0);
+    let t = if towards_centre { t0 } else { t1 };
+    if t.is_nan() || t <= 0.0 {
+        return None;
+    }
+    let p = r.origin + r.dir * t;
+    let mut n = (p - centre) / s.radius.abs();
+    if n.dot(r.dir) > 0.0 {
+        n = -n;
+    }
+    Some((p, n))
+}
+
+/// Snell's law: the unit direction refracted from unit `d` at a surface of
+/// unit normal `n` facing against `d`, with `eta` the ratio of the indices
+/// (incident over transmitted); `None` on total internal reflection.
+fn refract(d: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
+    let cos_i = -d.dot(n);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((d * eta + n * (eta * cos_i - cos_t)).normalize())
+}
+
+#[cfg(test)]
+mod tests;
