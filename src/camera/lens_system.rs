@@ -4,8 +4,9 @@
 //!
 //! # The lens file
 //! One row per surface, from the scene side (front) to the film side (rear),
-//! four numbers separated by spaces or tabs, in millimetres; `#` starts a
-//! comment, blank lines are skipped:
+//! four numbers separated by spaces or tabs, in millimetres, and an optional
+//! fifth column naming the glass after the surface; `#` starts a comment,
+//! blank lines are skipped:
 //!
 //! | column | meaning |
 //! |---|---|
@@ -13,18 +14,26 @@
 //! | thickness | the distance along the axis to the next surface (from the last: to the film, which focusing sets) |
 //! | index | the index of refraction of what follows the surface, towards the film (0 or 1: air) |
 //! | aperture | the surface's clear aperture, a diameter |
+//! | glass (optional) | what follows the surface disperses: a named glass (`N-BK7`, `F2`, any of [`NAMED_GLASSES`]: its Sellmeier index, which must agree with the index column within 0.005), or an Abbe number `V_d` (Cauchy's `n = A + B/λ²` through the index column at the d line, 587.56 nm, with `n_F − n_C = (n_d − 1) / V_d` between 486.13 and 656.27 nm) |
 //!
 //! ```text
-//! # radius  thickness  index  aperture
-//! 51.68     4          1.5168 25
+//! # radius  thickness  index  aperture  glass
+//! 51.68     4          1.5168 25        N-BK7
 //! -51.68    0          1      25
 //! ```
+//!
+//! Without a glass column a surface's index is the same at every wavelength
+//! (pbrt's lens files, one index per element). With one, each wavelength
+//! refracts with its own index, and the lens's focal length depends on the
+//! wavelength: longitudinal chromatic aberration.
 //!
 //! Every mistake is an error naming the file, the line and the column: a
 //! missing or extra column, a number that does not parse or is not finite, a
 //! negative or zero aperture, a negative thickness, an index below 1 (other
 //! than 0), a stop in glass, a surface whose radius is smaller than its
-//! aperture's, and two surfaces that cross inside their apertures.
+//! aperture's, two surfaces that cross inside their apertures, an unknown
+//! glass, an Abbe number that is not positive, a glass after air, and a named
+//! glass whose index at the d line is not the index column's.
 //!
 //! # Coordinates
 //! Lens space is right-handed with `z` along the optical axis, increasing
@@ -45,10 +54,17 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use crate::bxdf::{Ior, NAMED_GLASSES, named_glass};
 use crate::error::{Error, Result};
 
+/// The d line (helium, nm), where the index column holds.
+pub const D_LINE_NM: f32 = 587.56;
+/// The F and C lines (hydrogen, nm), between which an Abbe number's dispersion is measured.
+const F_LINE_NM: f64 = 486.13;
+const C_LINE_NM: f64 = 656.27;
+
 /// One surface of a lens system, in millimetres.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct LensSurface {
     /// Radius of curvature (positive: centre on the film side); 0 for the aperture stop.
     pub radius: f64,
@@ -58,6 +74,8 @@ pub struct LensSurface {
     pub index: f64,
     /// Half the clear aperture.
     pub aperture_radius: f64,
+    /// The dispersive glass after the surface (`None`: `index` at every wavelength).
+    pub glass: Option<Ior>,
 }
 
 impl LensSurface {
@@ -65,6 +83,15 @@ impl LensSurface {
     #[inline]
     pub fn is_stop(&self) -> bool {
         self.radius == 0.0
+    }
+
+    /// The index after the surface at wavelength `lambda_nm`.
+    #[inline]
+    pub fn index_at(&self, lambda_nm: f32) -> f64 {
+        match &self.glass {
+            Some(g) => g.at(lambda_nm) as f64,
+            None => self.index,
+        }
     }
 }
 
@@ -84,8 +111,10 @@ pub struct LensRay {
     pub dir: DVec3,
 }
 
-/// The four columns of a row, for error messages.
+/// The four numeric columns of a row, for error messages.
 const COLUMNS: [&str; 4] = ["radius", "thickness", "index", "aperture"];
+/// What a row holds, for error messages.
+const ROW: &str = "4 or 5 columns (radius, thickness, index, aperture diameter in mm; a glass)";
 
 impl LensSystem {
     /// Reads the lens file at `path` (see the module doc for the format).
@@ -128,25 +157,14 @@ impl LensSystem {
                 return Err(err(
                     line,
                     col,
-                    format!(
-                        "expected 4 columns (radius, thickness, index, aperture diameter in mm), found {}: the {} is missing",
-                        fields.len(),
-                        COLUMNS[fields.len()]
-                    ),
+                    format!("expected {ROW}, found {}: the {} is missing", fields.len(), COLUMNS[fields.len()]),
                 ));
             }
-            if fields.len() > 4 {
-                return Err(err(
-                    line,
-                    fields[4].0,
-                    format!(
-                        "expected 4 columns (radius, thickness, index, aperture diameter in mm), found {}",
-                        fields.len()
-                    ),
-                ));
+            if fields.len() > 5 {
+                return Err(err(line, fields[5].0, format!("expected {ROW}, found {}", fields.len())));
             }
             let mut v = [0.0f64; 4];
-            for (k, &(col, s)) in fields.iter().enumerate() {
+            for (k, &(col, s)) in fields.iter().take(4).enumerate() {
                 v[k] = match s.parse::<f64>() {
                     Ok(x) if x.is_finite() && x.abs() <= 1e9 => x,
                     _ => {
@@ -183,11 +201,16 @@ impl LensSystem {
                     format!("a sphere of radius {} cannot span the aperture diameter {aperture}", radius.abs()),
                 ));
             }
+            let glass = match fields.get(4) {
+                None => None,
+                Some(&(col, name)) => Some(glass(name, index).map_err(|m| err(line, col, m))?),
+            };
             surfaces.push(LensSurface {
                 radius,
                 thickness,
                 index: if index == 0.0 { 1.0 } else { index },
                 aperture_radius: aperture / 2.0,
+                glass,
             });
             rows.push((line, col(1)));
         }
@@ -196,7 +219,7 @@ impl LensSystem {
         }
         // Neighbouring surfaces must not cross inside their common aperture.
         for i in 0..surfaces.len() - 1 {
-            let (a, b) = (surfaces[i], surfaces[i + 1]);
+            let (a, b) = (&surfaces[i], &surfaces[i + 1]);
             let h = a.aperture_radius.min(b.aperture_radius);
             let gap = a.thickness + sag(b.radius, h) - sag(a.radius, h);
             if gap < -1e-9 {
@@ -228,11 +251,12 @@ impl LensSystem {
             .collect()
     }
 
-    /// Traces `ray` (from the scene side, going towards +z) through every
-    /// surface, front to rear. `None` when it misses a surface or the stop
-    /// inside its aperture, or is totally reflected. The ray returned starts
-    /// on the last surface, in the medium after it.
-    pub fn trace_from_scene(&self, ray: LensRay) -> Option<LensRay> {
+    /// Traces `ray` of wavelength `lambda_nm` (from the scene side, going
+    /// towards +z) through every surface, front to rear. `None` when it
+    /// misses a surface or the stop inside its aperture, or is totally
+    /// reflected. The ray returned starts on the last surface, in the medium
+    /// after it.
+    pub fn trace_from_scene(&self, ray: LensRay, lambda_nm: f32) -> Option<LensRay> {
         let z = self.vertices();
         let mut r = LensRay { origin: ray.origin, dir: ray.dir.normalize() };
         let mut eta_before = 1.0;
@@ -241,17 +265,19 @@ impl LensSystem {
             if p.x * p.x + p.y * p.y > s.aperture_radius * s.aperture_radius {
                 return None;
             }
-            let dir = if s.is_stop() { r.dir } else { refract(r.dir, n, eta_before / s.index)? };
+            let eta = s.index_at(lambda_nm);
+            let dir = if s.is_stop() { r.dir } else { refract(r.dir, n, eta_before / eta)? };
             r = LensRay { origin: p, dir };
-            eta_before = s.index;
+            eta_before = eta;
         }
         Some(r)
     }
 
-    /// Traces `ray` (from the film side, going towards −z) through every
-    /// surface, rear to front; `None` as for [`LensSystem::trace_from_scene`].
-    /// The ray returned starts on the front surface, in air.
-    pub fn trace_from_film(&self, ray: LensRay) -> Option<LensRay> {
+    /// Traces `ray` of wavelength `lambda_nm` (from the film side, going
+    /// towards −z) through every surface, rear to front; `None` as for
+    /// [`LensSystem::trace_from_scene`]. The ray returned starts on the front
+    /// surface, in air.
+    pub fn trace_from_film(&self, ray: LensRay, lambda_nm: f32) -> Option<LensRay> {
         let z = self.vertices();
         let mut r = LensRay { origin: ray.origin, dir: ray.dir.normalize() };
         for i in (0..self.surfaces.len()).rev() {
@@ -260,18 +286,24 @@ impl LensSystem {
             if p.x * p.x + p.y * p.y > s.aperture_radius * s.aperture_radius {
                 return None;
             }
-            let eta_after = if i > 0 { self.surfaces[i - 1].index } else { 1.0 };
-            let dir = if s.is_stop() { r.dir } else { refract(r.dir, n, s.index / eta_after)? };
+            let eta_after = if i > 0 { self.surfaces[i - 1].index_at(lambda_nm) } else { 1.0 };
+            let dir = if s.is_stop() { r.dir } else { refract(r.dir, n, s.index_at(lambda_nm) / eta_after)? };
             r = LensRay { origin: p, dir };
         }
         Some(r)
     }
 
-    /// The rear cardinal points from a ray parallel to the axis at height
-    /// `h` (mm) from the scene: `(principal plane z, focal point z)`; `None`
-    /// if the ray does not pass or leaves parallel to the axis.
-    pub fn rear_cardinal_points(&self, h: f64) -> Option<(f64, f64)> {
-        let r = self.trace_from_scene(LensRay { origin: DVec3::new(h, 0.0, -1.0), dir: DVec3::Z })?;
+    /// True when some glass of the lens disperses (a glass column).
+    pub fn is_dispersive(&self) -> bool {
+        self.surfaces.iter().any(|s| s.glass.as_ref().is_some_and(Ior::is_dispersive))
+    }
+
+    /// The rear cardinal points at wavelength `lambda_nm` from a ray parallel
+    /// to the axis at height `h` (mm) from the scene: `(principal plane z,
+    /// focal point z)`; `None` if the ray does not pass or leaves parallel to
+    /// the axis.
+    pub fn rear_cardinal_points(&self, h: f64, lambda_nm: f32) -> Option<(f64, f64)> {
+        let r = self.trace_from_scene(LensRay { origin: DVec3::new(h, 0.0, -1.0), dir: DVec3::Z }, lambda_nm)?;
         // Where the outgoing ray crosses the axis, and where it is at height h.
         if r.dir.x == 0.0 || r.dir.z <= 0.0 {
             return None;
@@ -281,25 +313,56 @@ impl LensSystem {
         Some((principal, focus))
     }
 
-    /// The paraxial effective focal length (mm): from the rear principal
-    /// plane to the rear focal point, by a ray at a small height (10⁻⁴ of
-    /// the front aperture's radius, where the exact trace is paraxial to
-    /// about 10⁻⁸).
-    pub fn effective_focal_length(&self) -> Option<f64> {
-        let (principal, focus) = self.rear_cardinal_points(self.paraxial_height())?;
+    /// The paraxial effective focal length (mm) at wavelength `lambda_nm`:
+    /// from the rear principal plane to the rear focal point, by a ray at a
+    /// small height (10⁻⁴ of the front aperture's radius, where the exact
+    /// trace is paraxial to about 10⁻⁸).
+    pub fn effective_focal_length(&self, lambda_nm: f32) -> Option<f64> {
+        let (principal, focus) = self.rear_cardinal_points(self.paraxial_height(), lambda_nm)?;
         Some(focus - principal)
     }
 
-    /// The paraxial back focal distance (mm): from the last surface's vertex
-    /// to the rear focal point (see [`LensSystem::effective_focal_length`]).
-    pub fn back_focal_distance(&self) -> Option<f64> {
-        let (_, focus) = self.rear_cardinal_points(self.paraxial_height())?;
+    /// The paraxial back focal distance (mm) at wavelength `lambda_nm`: from
+    /// the last surface's vertex to the rear focal point (see
+    /// [`LensSystem::effective_focal_length`]). Its change with the
+    /// wavelength is the longitudinal chromatic aberration.
+    pub fn back_focal_distance(&self, lambda_nm: f32) -> Option<f64> {
+        let (_, focus) = self.rear_cardinal_points(self.paraxial_height(), lambda_nm)?;
         let last = *self.vertices().last()?;
         Some(focus - last)
     }
 
     fn paraxial_height(&self) -> f64 {
         self.surfaces[0].aperture_radius * 1e-4
+    }
+}
+
+/// The glass column `name` of a row whose index column is `index`: a named
+/// glass agreeing with the index at the d line, or an Abbe number; an error
+/// message otherwise.
+fn glass(name: &str, index: f64) -> std::result::Result<Ior, String> {
+    if index <= 1.0 {
+        return Err(format!("a glass (`{name}`) after air: the index column is {index}, expected more than 1"));
+    }
+    if let Some(g) = named_glass(name) {
+        let n_d = g.at(D_LINE_NM) as f64;
+        if (n_d - index).abs() > 5e-3 {
+            return Err(format!("{name}'s index at the d line is {n_d:.4}, but the index column says {index}"));
+        }
+        return Ok(g);
+    }
+    match name.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => {
+            // n_F − n_C = (n_d − 1) / V_d, and Cauchy through n_d.
+            let b = (index - 1.0) / v / (1.0 / (F_LINE_NM * 1e-3).powi(2) - 1.0 / (C_LINE_NM * 1e-3).powi(2));
+            let a = index - b / (D_LINE_NM as f64 * 1e-3).powi(2);
+            Ok(Ior::Cauchy { a: a as f32, b: b as f32 })
+        }
+        Ok(v) => Err(format!("an Abbe number must be positive, found {v}")),
+        Err(_) => {
+            let names: Vec<&str> = NAMED_GLASSES.iter().map(|g| g.0).collect();
+            Err(format!("expected a glass name ({}) or an Abbe number, found `{name}`", names.join(", ")))
+        }
     }
 }
 
