@@ -313,6 +313,74 @@ impl LensSystem {
         Some((principal, focus))
     }
 
+    /// The front cardinal points at wavelength `lambda_nm` from a ray
+    /// parallel to the axis at height `h` (mm) from the film side: `(principal
+    /// plane z, focal point z)`; `None` as for [`LensSystem::rear_cardinal_points`].
+    pub fn front_cardinal_points(&self, h: f64, lambda_nm: f32) -> Option<(f64, f64)> {
+        let behind = self.vertices().last()? + self.surfaces.last()?.thickness + 1.0;
+        let r = self.trace_from_film(LensRay { origin: DVec3::new(h, 0.0, behind), dir: DVec3::NEG_Z }, lambda_nm)?;
+        if r.dir.x == 0.0 || r.dir.z >= 0.0 {
+            return None;
+        }
+        let focus = r.origin.z - r.origin.x * r.dir.z / r.dir.x;
+        let principal = r.origin.z + (h - r.origin.x) * r.dir.z / r.dir.x;
+        Some((principal, focus))
+    }
+
+    /// This lens with its film placed so that the plane `distance` mm in
+    /// front of the film is in focus at the d line: the last surface's
+    /// thickness becomes the distance to the film. pbrt-v4's
+    /// `FocusThickLens`, solved exactly for the thick-lens approximation: with
+    /// the principal planes `P` (front) and `P'` (rear) and the focal length
+    /// `f`, an object `s` in front of `P` images `s'` behind `P'` with
+    /// `1/s + 1/s' = 1/f`, and `s + s' = L`, the conjugates' distance less the
+    /// principal planes' separation, gives `s' = (L − √(L² − 4fL)) / 2` (the
+    /// image near the focal plane). An error message when the plane in focus
+    /// would lie inside the lens, nearer than the lens can focus (`L < 4f`),
+    /// or with the film inside the lens.
+    pub fn focused(&self, distance: f64) -> std::result::Result<LensSystem, String> {
+        let h = self.paraxial_height();
+        let rear = self.rear_cardinal_points(h, D_LINE_NM);
+        let front = self.front_cardinal_points(h, D_LINE_NM);
+        let (Some((p_rear, f_rear)), Some((p_front, _))) = (rear, front) else {
+            return Err(
+                "the lens does not form an image: a ray near the axis does not pass it or leaves it parallel".into()
+            );
+        };
+        let f = f_rear - p_rear;
+        if f.is_nan() || f <= 0.0 {
+            return Err(format!("the lens diverges (focal length {f:.4} mm): it cannot focus on a film"));
+        }
+        let l = distance - (p_rear - p_front);
+        if l < 4.0 * f {
+            return Err(format!(
+                "{distance} mm from the film is nearer than this lens can focus: at least {:.4} mm (object and image 4f apart, f {f:.4} mm)",
+                4.0 * f + (p_rear - p_front)
+            ));
+        }
+        let film = p_rear + 0.5 * (l - (l * l - 4.0 * f * l).sqrt());
+        let z = self.vertices();
+        let last = self.surfaces.last().expect("a lens has surfaces");
+        let rear_edge = z[z.len() - 1] + sag(last.radius, last.aperture_radius).max(0.0);
+        if film <= rear_edge {
+            return Err(format!("focusing at {distance} mm puts the film inside the lens"));
+        }
+        if film - distance >= 0.0 {
+            return Err(format!(
+                "the plane in focus, {distance} mm from the film, is inside the lens ({:.4} mm from its front to the film)",
+                film
+            ));
+        }
+        let mut lens = self.clone();
+        lens.surfaces.last_mut().expect("a lens has surfaces").thickness = film - z[z.len() - 1];
+        Ok(lens)
+    }
+
+    /// The film's `z` (the last vertex plus the last thickness).
+    pub fn film_z(&self) -> f64 {
+        self.vertices().last().copied().unwrap_or(0.0) + self.surfaces.last().map_or(0.0, |s| s.thickness)
+    }
+
     /// The paraxial effective focal length (mm) at wavelength `lambda_nm`:
     /// from the rear principal plane to the rear focal point, by a ray at a
     /// small height (10⁻⁴ of the front aperture's radius, where the exact

@@ -227,3 +227,42 @@ fn lens_file_errors_name_the_file_line_and_column() {
     assert_eq!(lens.surfaces[1].index, 1.0);
     assert_eq!(lens.vertices(), vec![0.0, 2.0, 3.0]);
 }
+
+/// Focusing places the film where the lens images the plane in focus: a ray
+/// from the on-axis point `distance` in front of the film, at a small angle,
+/// traced through each shipped lens crosses the axis again on the film
+/// (within 1e-5 of the distance; the trace, not the thick-lens formula
+/// under test, decides where); at a great distance the film sits at the back
+/// focal distance. Too near, or inside the lens, is an error.
+#[test]
+fn focusing_images_the_plane_in_focus_on_the_film() {
+    for name in SHIPPED {
+        let lens = LensSystem::load(&lens_file(name)).unwrap();
+        let f = lens.effective_focal_length(D_LINE_NM).unwrap();
+        for distance in [5.0 * f, 1000.0, 1e5] {
+            let focused = lens.focused(distance).unwrap_or_else(|e| panic!("{name} at {distance}: {e}"));
+            let film = focused.film_z();
+            let object = film - distance;
+            let h = lens.surfaces[0].aperture_radius * 1e-4;
+            let ray = LensRay { origin: DVec3::new(0.0, 0.0, object), dir: DVec3::new(0.0, h, -object).normalize() };
+            let out = focused.trace_from_scene(ray, D_LINE_NM).expect("the ray passes");
+            let crossing = out.origin.z - out.origin.y * out.dir.z / out.dir.y;
+            assert!(
+                (crossing - film).abs() < 1e-5 * distance,
+                "{name} at {distance}: image at {crossing}, film at {film}"
+            );
+        }
+        let far = lens.focused(1e9).unwrap();
+        let bfd = lens.back_focal_distance(D_LINE_NM).unwrap();
+        let last = far.surfaces.last().unwrap().thickness;
+        assert!((last - bfd).abs() < 1e-3, "{name}: film {last} mm behind the lens at infinity, BFD {bfd}");
+    }
+    let dgauss = LensSystem::load(&lens_file("dgauss.50mm.dat")).unwrap();
+    let e = dgauss.focused(150.0).unwrap_err();
+    assert!(e.contains("nearer than this lens can focus"), "{e}");
+    let singlet = LensSystem::load(&lens_file("singlet.50mm.dat")).unwrap();
+    // A thin lens cannot bring an object nearer than 4f to a real image.
+    assert!(singlet.focused(150.0).unwrap_err().contains("at least 20"));
+    let diverging = LensSystem::parse("-20 2 1.5 10\n20 5 1 10\n", Path::new("x.dat")).unwrap();
+    assert!(diverging.focused(1000.0).unwrap_err().contains("diverges"));
+}
