@@ -19,10 +19,14 @@
 //! camera: (eye: (0, 1, 3.5), look_at: (0, 1, 0), up: (0, 1, 0), fov_deg: 45),
 //! ```
 
+mod lens_camera;
 pub mod lens_system;
 mod thin_lens;
 
+pub use lens_camera::{LensCamera, LensSample};
 pub use thin_lens::ThinLens;
+
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -39,8 +43,11 @@ pub struct Camera {
     tan_half_x: f32,
     width: u32,
     height: u32,
-    /// The thin lens (`None`: a pinhole at `eye`).
+    /// The thin lens (`None`: a pinhole at `eye`, or a lens system).
     lens: Option<ThinLens>,
+    /// A lens system in front of a film (then `lens` is `None`; the field of
+    /// view above is the system's, for the pinhole methods only).
+    system: Option<Arc<LensCamera>>,
 }
 
 impl Camera {
@@ -57,7 +64,7 @@ impl Camera {
         let up = right.cross(forward);
         let tan_half_y = (fov_deg.to_radians() * 0.5).tan();
         let tan_half_x = tan_half_y * width as f32 / height as f32;
-        Camera { eye, forward, right, up, tan_half_y, tan_half_x, width, height, lens: None }
+        Camera { eye, forward, right, up, tan_half_y, tan_half_x, width, height, lens: None, system: None }
     }
 
     /// This camera with a thin lens of radius `radius` focused on the plane at
@@ -65,6 +72,31 @@ impl Camera {
     pub fn with_thin_lens(mut self, radius: f32, focus: f32) -> Self {
         self.lens = (radius > 0.0).then_some(ThinLens { radius, focus });
         self
+    }
+
+    /// This camera looking through the lens system `system` (its front
+    /// vertex at the eye), instead of a pinhole or thin lens.
+    pub fn with_lens_system(mut self, system: LensCamera) -> Self {
+        self.lens = None;
+        self.system = Some(Arc::new(system));
+        self
+    }
+
+    /// The lens system, if the camera looks through one.
+    #[inline]
+    pub fn lens_system(&self) -> Option<&LensCamera> {
+        self.system.as_deref()
+    }
+
+    /// The camera ray through the lens system for film position `film`,
+    /// exit-pupil sample `u` and wavelength `lambda_nm`, in world space, with
+    /// its weight; `None` without a lens system or when the lens blocks it.
+    #[inline]
+    pub fn lens_system_ray(&self, film: Vec2, u: Vec2, lambda_nm: f32) -> Option<(Ray, f32)> {
+        let s = self.system.as_ref()?.ray(film, u, lambda_nm)?;
+        let origin = self.eye + self.right * s.origin.x + self.up * s.origin.y + self.forward * s.origin.z;
+        let dir = (self.right * s.dir.x + self.up * s.dir.y + self.forward * s.dir.z).normalize();
+        Some((Ray::new(origin, dir), s.weight))
     }
 
     /// The thin lens, if the camera has one.
