@@ -91,6 +91,13 @@ pub(crate) enum Transport {
 }
 
 impl Transport {
+    /// True when the transport follows dispersion (`auto`, `spectral`); `path`
+    /// and `whitted` refract every wavelength alike, a dispersive lens too.
+    #[inline]
+    fn disperses(&self) -> bool {
+        matches!(self, Transport::Path(p) if p.disperse)
+    }
+
     /// Radiance along `ray` for the packet `lambdas`, as XYZ.
     #[inline]
     pub fn li<const N: usize, O: Contribution>(
@@ -115,7 +122,7 @@ impl Estimator for FullSpectrum {
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
         if let Some(system) = scene.camera.lens_system() {
             let u = sampler.get_2d(Dim::LENS);
-            if system.is_dispersive() {
+            if system.is_dispersive() && self.0.disperses() {
                 let one = one_wavelength::<O>(sampler.get_1d(Dim::wavelength(0)));
                 return through_lens_system(&self.0, scene, film, u, &one, sampler);
             }
@@ -186,7 +193,7 @@ fn through_lens_system<const N: usize, O: Contribution>(
 ) -> O {
     let cam = &scene.camera;
     let dispersive = cam.lens_system().is_some_and(|s| s.is_dispersive());
-    let nm = if N == 1 && dispersive { lambdas.lambda_nm(0) } else { D_LINE_NM };
+    let nm = if N == 1 && dispersive && transport.disperses() { lambdas.lambda_nm(0) } else { D_LINE_NM };
     match cam.lens_system_ray(film, u, nm) {
         Some((ray, w)) => transport.li(scene, ray, &Lambdas { weight: lambdas.weight * w, ..*lambdas }, sampler),
         None => O::default(),
@@ -284,6 +291,23 @@ pub fn needs_bdpt(scene: &Scene) -> bool {
 /// One line saying which light-transport model the settings pick for this
 /// scene and why (printed once by `rust-v render`).
 pub fn describe(scene: &Scene) -> String {
+    let line = describe_transport(scene);
+    match scene.camera.lens_system() {
+        Some(lens) if lens.is_dispersive() => match scene.settings.integrator {
+            IntegratorKind::Auto => format!(
+                "{line}; the camera's lens disperses: one continuous wavelength per camera sample, drawn by visual importance, on its own ray through the lens"
+            ),
+            IntegratorKind::Spectral => format!(
+                "{line}; the camera's lens disperses: each wavelength of a packet on its own ray through the lens"
+            ),
+            _ => format!("{line}; the camera's lens refracts every wavelength like the d line (587.56 nm)"),
+        },
+        _ => line,
+    }
+}
+
+/// [`describe`] without the camera's lens.
+fn describe_transport(scene: &Scene) -> String {
     let s = &scene.settings;
     let dispersive = scene.has_dispersion();
     match s.integrator {
