@@ -476,6 +476,38 @@ fn mesh_transform_errors_name_the_field() {
     }
 }
 
+/// The thin lens's fields (issue 32): a negative or NaN aperture, a focus
+/// distance of 0, negative or infinite: one error line naming the field. A
+/// huge aperture is no error and renders without a NaN (the film would count it).
+#[test]
+fn thin_lens_errors_name_the_field() {
+    let d = temp_dir("hostile-lens");
+    let cases = [
+        ("aperture_radius: -0.1", "camera.aperture_radius"),
+        ("aperture_radius: NaN", "camera.aperture_radius"),
+        ("aperture_radius: inf", "camera.aperture_radius"),
+        ("aperture_radius: 0.1, focus_distance: 0", "camera.focus_distance"),
+        ("aperture_radius: 0.1, focus_distance: -2", "camera.focus_distance"),
+        ("focus_distance: NaN", "camera.focus_distance"),
+        ("aperture_radius: 0.1, focus_distance: inf", "camera.focus_distance"),
+    ];
+    for (fields, want) in cases {
+        let p = d.join("t.ron");
+        std::fs::write(&p, SCENE.replace("fov_deg: 30)", &format!("fov_deg: 30, {fields})"))).unwrap();
+        let e = one_error(&run(&["render", s(&p), "-o", s(&d.join("t.png"))]), 1);
+        assert!(e.contains(want) && e.contains("t.ron"), "{fields}: {e}");
+    }
+    let p = d.join("huge.ron");
+    std::fs::write(&p, SCENE.replace("fov_deg: 30)", "fov_deg: 30, aperture_radius: 1e15, focus_distance: 1e-3)"))
+        .unwrap();
+    for integrator in ["path", "bdpt", "lighttrace"] {
+        let o = run(&["render", s(&p), "--integrator", integrator, "-o", s(&d.join("huge.png"))]);
+        let err = stderr(&o);
+        assert!(o.status.success(), "{integrator}: {err}");
+        assert!(!err.contains("NaN or infinite"), "{integrator}: {err}");
+    }
+}
+
 // ---------------------------------------------------------------------------
 // 8. Consistent limits.
 

@@ -7,6 +7,7 @@ mod common;
 
 mod auto;
 mod bdpt;
+mod camera;
 mod checkpoint;
 mod cli;
 mod docs;

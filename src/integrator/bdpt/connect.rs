@@ -17,31 +17,33 @@ use super::vertex::{
 use super::{Bdpt, Sub};
 
 impl Bdpt {
-    /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye. Returns
-    /// the film position and the MIS-weighted contribution.
+    /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye, or by a
+    /// point of a thin lens drawn uniformly ([`Dim::lens_from_light`], pbrt-v4's
+    /// `PerspectiveCamera::SampleWi`). Returns the film position and the
+    /// MIS-weighted contribution.
     pub(super) fn connect_camera(
         &self,
         scene: &Scene,
         light: Sub<'_>,
         s: usize,
         camera: Sub<'_>,
+        sampler: &mut Sampler,
         wl: &mut Wavelength,
     ) -> Option<(Vec2, Contrib)> {
+        let cam = &scene.camera;
+        let eye =
+            if cam.has_lens() { cam.lens_point(sampler.get_2d(Dim::lens_from_light(s as u32 - 1))) } else { cam.eye() };
         let qs = &light.v[s - 1];
         if !connectible(scene, qs) {
             return None;
         }
-        let cam = &scene.camera;
-        let eye = cam.eye();
         let to_eye = eye - qs.p();
         let d2 = to_eye.length_squared();
         if d2.is_nan() || d2 <= 0.0 {
             return None;
         }
         let w = to_eye / d2.sqrt();
-        let film = cam.project(-w)?;
-        let cos_cam = (-w).dot(cam.forward());
-        let importance = 1.0 / (d2 * cam.plane_area() * cos_cam * cos_cam * cos_cam);
+        let (film, importance) = cam.importance(eye, -w, d2)?;
         let single = qs.collapsed || is_dispersive(scene, qs);
         // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
         let c = match qs.kind {
@@ -84,8 +86,9 @@ impl Bdpt {
         let weight = if self.light_only {
             1.0
         } else {
-            let eye_v = &camera.v[0];
-            let qs_rev = to_area(scene, cam.pdf_dir(-w), eye_v, qs);
+            // The camera vertex of this strategy: the eye, or the lens point drawn here.
+            let eye_v = Vertex::at_point(Kind::Camera, eye, cam.forward(), Spectrum::ONE, 1.0);
+            let qs_rev = to_area(scene, cam.pdf_dir_from(eye, -w), &eye_v, qs);
             let qsm_rev = match qs.kind {
                 Kind::Surface(_) if s >= 2 => pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev,
                 _ => 0.0,

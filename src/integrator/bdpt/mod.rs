@@ -106,7 +106,7 @@ use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
 
-use super::Estimator;
+use super::{Estimator, camera_ray};
 use vertex::{Contrib, Kind, Vertex, Wavelength};
 use walk::Walk;
 
@@ -192,7 +192,7 @@ impl Estimator for Bdpt {
             } else if scene.has_environment() {
                 // Light tracing cannot reach the eye from infinity: the environment
                 // seen directly is the pixel ray's, unweighted (the only strategy).
-                let ray = scene.camera.ray(film);
+                let ray = camera_ray(scene, film, sampler);
                 if scene.intersect(&ray, f32::INFINITY).is_none()
                     && scene.medium_in(scene.camera_volumes.current()).is_none()
                     && let Some((_, le)) = scene.escaped(ray.dir)
@@ -210,7 +210,7 @@ impl Estimator for Bdpt {
                         continue;
                     }
                     if t == 1 {
-                        if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, &mut wl) {
+                        if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, sampler, &mut wl) {
                             let value = match c {
                                 Contrib::Full(c) => O::from_packet(&full, &c),
                                 Contrib::Single(v) => O::from_packet(&wl.single().lambdas, &Sampled([v])),
@@ -246,12 +246,12 @@ impl Bdpt {
         wl: &mut Wavelength,
     ) {
         let cam = &scene.camera;
-        let ray = cam.ray(film);
+        let ray = camera_ray(scene, film, sampler);
         path.push(Vertex::at_point(Kind::Camera, ray.origin, cam.forward(), Spectrum::ONE, 1.0));
         if let Some(stacks) = stacks.as_deref_mut() {
             stacks.push(scene.camera_volumes);
         }
-        let pdf_dir = cam.pdf_dir(ray.dir);
+        let pdf_dir = cam.pdf_dir_from(ray.origin, ray.dir);
         let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2 };
         walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_volumes, wl);
     }
