@@ -16,6 +16,7 @@ mod furnace;
 mod fuzz;
 mod hostile;
 mod lights;
+mod media;
 mod memory;
 mod metrics;
 mod output;

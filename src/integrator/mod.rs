@@ -257,7 +257,11 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
         Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
     };
     match settings.integrator {
-        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => f.call(&bdpt(false)),
+        IntegratorKind::Auto
+            if needs_bdpt(scene) && scene.camera.lens_system().is_none() && !scene.has_scattering() =>
+        {
+            f.call(&bdpt(false))
+        }
         IntegratorKind::Auto => f.call(&FullSpectrum(path(true))),
         IntegratorKind::Bdpt => f.call(&bdpt(false)),
         IntegratorKind::LightTrace => f.call(&bdpt(true)),
@@ -311,7 +315,7 @@ fn describe_transport(scene: &Scene) -> String {
     let s = &scene.settings;
     let dispersive = scene.has_dispersion();
     match s.integrator {
-        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => format!(
+        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() && !scene.has_scattering() => format!(
             "auto: a point, spot, distant or beam light meets a specular surface (caustics path tracing cannot find): bidirectional path tracing{}",
             if dispersive { "; the full spectrum until a subpath refracts at dispersive glass, then one wavelength" } else { ", full spectrum" }
         ),
@@ -436,7 +440,7 @@ pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut VolumeStack, si: &Surf
         return Interface::Scatter { outside: Outside::VACUUM, crossing: None };
     };
     let entering = dir.dot(si.hit.n) < 0.0;
-    match media.crossing(m, entering) {
+    match scene.crossing(media, m, entering) {
         Crossing::Pass => {
             media.cross(m, entering);
             Interface::Pass
@@ -494,6 +498,46 @@ pub(crate) fn sample_direct<const N: usize>(
     };
     let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
     f * le * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+}
+
+/// One next-event estimate at a scattering event at `p` in a medium (the
+/// path arrived travelling along `−wo`): a light chosen by power, a point on
+/// it, a shadow ray through [`Scene::transmittance`] from the volumes `volumes`
+/// (the medium's transmittance on the way), the phase function's value, and
+/// the MIS weight against phase sampling (power heuristic). Its numbers are
+/// the next-event draws of depth `depth`, as a surface vertex's.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub(crate) fn sample_direct_medium<const N: usize>(
+    scene: &Scene,
+    phase: &crate::medium::HenyeyGreenstein,
+    p: Vec3,
+    wo: Vec3,
+    volumes: &VolumeStack,
+    lambdas: &Lambdas<N>,
+    sampler: &mut Sampler,
+    depth: u32,
+) -> Sampled<N> {
+    let zero = Sampled::splat(0.0);
+    let u_light = sampler.get_1d_if(scene.light_count() > 1, Dim::light_choice(depth));
+    let u = sampler.get_2d(Dim::light_sample(depth));
+    let Some(choice) = scene.sample_li(p, u_light, u) else {
+        return zero;
+    };
+    let ls = choice.sample;
+    let f = phase.eval(wo, ls.wi);
+    if !(f > 0.0) {
+        return zero;
+    }
+    let Some(clear) = scene.transmittance(p, Vec3::ZERO, Some(volumes), ls.point, ls.n) else {
+        return zero;
+    };
+    let mut t = Sampled::splat(f);
+    clear.attenuate(&mut t, lambdas);
+    let pdf_light = choice.pmf * ls.pdf;
+    let weight = if ls.is_delta { 1.0 } else { power_heuristic(pdf_light, f) };
+    let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
+    t * le * (ls.scale * weight / pdf_light)
 }
 
 #[cfg(test)]

@@ -132,6 +132,7 @@ fn bxdf_of<'a>(
             Bxdf::ThinSheet(ThinSheet { film: thin_film(check, field, *thickness_nm, ior)? })
         }
         MaterialDesc::Black => Bxdf::Black,
+        MaterialDesc::Interface => Bxdf::Interface,
     })
 }
 

@@ -140,6 +140,12 @@ impl Dim {
         Dim::bounce(depth, 4)
     }
 
+    /// A scattering medium at depth `depth`: where the path scatters (1D; slot 7).
+    #[inline]
+    pub fn medium_distance(depth: u32) -> Dim {
+        Dim::bounce(depth, 7)
+    }
+
     /// `auto` at dispersive glass at depth `depth`: reflect, or collapse (1D).
     #[inline]
     pub fn collapse(depth: u32) -> Dim {

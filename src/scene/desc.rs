@@ -48,6 +48,10 @@ pub struct SceneDesc {
     /// Lights that are not objects (point lights).
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// Named participating media, referred to by objects' `interior:`
+    /// (`crate::medium`): `media: { "milk": Homogeneous(sigma_a: ..., sigma_s: ..., phase: HenyeyGreenstein(g: 0.7)) }`.
+    #[serde(default)]
+    pub media: NamedMap<MediumDesc>,
     /// Radiance from infinitely far away, seen by every ray that escapes
     /// (`crate::light::EnvironmentLight`); none by default (escaping rays see black).
     #[serde(default)]
@@ -104,33 +108,89 @@ fn one() -> f32 {
     1.0
 }
 
-/// The `materials` map in file order; a name given twice is an error
-/// (`duplicate material "white"`), where a plain map would keep the last.
-#[derive(Debug, Default)]
-pub struct Materials(pub Vec<(String, MaterialDesc)>);
+/// A map from names to descriptions in file order (`materials`, `media`); a
+/// name given twice is an error (`duplicate material "white"`), where a plain
+/// map would keep the last.
+#[derive(Debug)]
+pub struct NamedMap<T>(pub Vec<(String, T)>);
 
-impl<'de> Deserialize<'de> for Materials {
+/// The `materials` map.
+pub type Materials = NamedMap<MaterialDesc>;
+
+impl<T> Default for NamedMap<T> {
+    fn default() -> Self {
+        NamedMap(Vec::new())
+    }
+}
+
+/// What a [`NamedMap`]'s entries are called in errors.
+pub trait Noun {
+    /// `material`, `medium`.
+    const NOUN: &'static str;
+}
+
+impl Noun for MaterialDesc {
+    const NOUN: &'static str = "material";
+}
+
+impl Noun for MediumDesc {
+    const NOUN: &'static str = "medium";
+}
+
+impl<'de, T: Deserialize<'de> + Noun> Deserialize<'de> for NamedMap<T> {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct Visit;
-        impl<'de> serde::de::Visitor<'de> for Visit {
-            type Value = Materials;
+        struct Visit<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Noun> serde::de::Visitor<'de> for Visit<T> {
+            type Value = NamedMap<T>;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a map from material names to materials")
+                write!(f, "a map from {} names to descriptions", T::NOUN)
             }
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Materials, A::Error> {
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<NamedMap<T>, A::Error> {
                 let mut seen = BTreeSet::new();
                 let mut out = Vec::new();
                 while let Some(name) = map.next_key::<String>()? {
                     if !seen.insert(name.clone()) {
-                        return Err(serde::de::Error::custom(format!("duplicate material \"{name}\"")));
+                        return Err(serde::de::Error::custom(format!("duplicate {} \"{name}\"", T::NOUN)));
                     }
                     out.push((name, map.next_value()?));
                 }
-                Ok(Materials(out))
+                Ok(NamedMap(out))
             }
         }
-        d.deserialize_map(Visit)
+        d.deserialize_map(Visit(std::marker::PhantomData))
     }
+}
+
+/// A participating medium (`crate::medium`): coefficients per scene unit.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MediumDesc {
+    /// The same everywhere:
+    /// `Homogeneous(sigma_a: Constant(0.01), sigma_s: Rayleigh(0.5), phase: Isotropic)`.
+    Homogeneous {
+        /// Absorption coefficient per scene unit.
+        sigma_a: SpectrumDesc,
+        /// Scattering coefficient per scene unit.
+        sigma_s: SpectrumDesc,
+        /// The phase function (default `Isotropic`).
+        #[serde(default)]
+        phase: PhaseDesc,
+    },
+}
+
+/// A medium's phase function.
+#[derive(Clone, Copy, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum PhaseDesc {
+    /// The same in every direction (the default).
+    #[default]
+    Isotropic,
+    /// Henyey-Greenstein of mean cosine `g` in [−0.999, 0.999] (> 0 forward):
+    /// `HenyeyGreenstein(g: 0.7)`.
+    HenyeyGreenstein {
+        /// The mean cosine of the scattering angle.
+        g: f32,
+    },
 }
 
 /// A pinhole camera, a thin lens with depth of field, or a lens system.
@@ -207,6 +267,8 @@ pub enum SpectrumDesc {
     /// A two-column CSV file (`nm,value` per line, relative to the scene file; a header line,
     /// blank lines and `#` comments are allowed), read like `Table`: `File("data/led.csv")`.
     File(String),
+    /// Scattering that falls as λ⁻⁴ (Rayleigh): `s · (550 nm / λ)⁴`: `Rayleigh(0.5)`.
+    Rayleigh(f32),
     /// Linear sRGB, uplifted to a smooth spectrum (Jakob and Hanika 2019): as a reflectance
     /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
     /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
@@ -349,6 +411,9 @@ pub enum MaterialDesc {
         #[serde(default)]
         roughness: f32,
     },
+    /// An index-matched boundary (`Interface`): light passes straight through; it
+    /// bounds the volume its object's `interior:` medium fills.
+    Interface,
     /// A free-standing thin film (soap film): `ThinSheet(thickness_nm: 400, ior: Constant(1.33))`.
     ThinSheet {
         /// Thickness in nm.
@@ -492,6 +557,10 @@ pub struct ObjectDesc {
     /// (default: as given). See [`TransformDesc`] for what each shape accepts.
     #[serde(default)]
     pub transform: Option<TransformDesc>,
+    /// The name of a medium in `media` filling the object's inside (its
+    /// material must be a `Dielectric` or an `Interface`): `interior: "milk"`.
+    #[serde(default)]
+    pub interior: Option<String>,
 }
 
 /// An object's placement, applied to its shape: scale, then rotate about x, then y,

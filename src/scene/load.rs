@@ -158,6 +158,11 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         materials.push(bxdf);
         textures.push(texture);
     }
+    // Media by name.
+    let mut media = BTreeMap::new();
+    for (name, m) in &desc.media.0 {
+        media.insert(name.as_str(), crate::medium::from_desc(ctx, &format!("media.\"{name}\""), m)?);
+    }
 
     // Every mesh file is read, parsed and built (with its BVH) at once on the
     // thread pool; the loop below takes them in object order, so the scene,
@@ -217,7 +222,31 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
                 Some(lights.len() as u32 - 1)
             }
         };
-        objects.push(Object { shape, material, light, priority: o.priority });
+        let interior = match &o.interior {
+            None => None,
+            Some(name) => {
+                let field = format!("{field}.interior");
+                let m = media.get(name.as_str()).ok_or_else(|| {
+                    let known: Vec<&str> = media.keys().copied().collect();
+                    ctx.err(&field, format!("unknown medium \"{name}\"; defined: {}", known.join(", ")))
+                })?;
+                let bxdf = &materials[material as usize];
+                if !bxdf.bounds_volume() {
+                    return Err(ctx.err(
+                        &field,
+                        "an interior needs a material that bounds a volume: a Dielectric or an Interface",
+                    ));
+                }
+                if bxdf.absorption().is_some() {
+                    return Err(ctx.err(
+                        &field,
+                        "the material has an `absorption:` (itself an interior medium); give one or the other",
+                    ));
+                }
+                Some(Box::new(m.clone()))
+            }
+        };
+        objects.push(Object { shape, material, light, priority: o.priority, interior });
     }
     for (i, l) in desc.lights.iter().enumerate() {
         lights.push(Light::from_desc(ctx, &format!("lights[{i}]"), l)?);
@@ -227,6 +256,15 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     }
     if objects.is_empty() {
         return Err(ctx.err("objects", "expected at least one object"));
+    }
+    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace)
+        && let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.scatters()))
+    {
+        return Err(ctx.err(
+            format!("objects[{i}].interior"),
+            "a scattering medium: bdpt and lighttrace do not sample media yet (they would ignore the light it \
+             scatters); use auto, path or spectral",
+        ));
     }
 
     let c = &desc.camera;

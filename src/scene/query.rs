@@ -127,7 +127,7 @@ impl Scene {
     /// The medium filling `volume` (`None`: vacuum, or a clear volume).
     #[inline]
     pub fn medium_in(&self, volume: Option<Volume>) -> Option<&Medium> {
-        self.media[volume?.material as usize].as_ref()
+        self.objects[volume?.object as usize].interior.as_deref()
     }
 
     /// The light of object `object`, when it emits.
@@ -197,6 +197,26 @@ impl Scene {
         }
     }
 
+    /// What crossing volume `v`'s surface (`entering` it or not) is for a path
+    /// in `stack`: as [`VolumeStack::crossing`] says, except that an
+    /// index-matched boundary (`Interface`) is always passed straight
+    /// through: no vertex, only a change of medium (so the light sample taken
+    /// before it, which [`Scene::transmittance`] takes through it, keeps its
+    /// MIS weight).
+    #[inline]
+    pub fn crossing(&self, stack: &VolumeStack, v: Volume, entering: bool) -> Crossing {
+        match stack.crossing(v, entering) {
+            Crossing::Interface { .. } if self.interfaces && self.bsdf(v.object).is_interface() => Crossing::Pass,
+            c => c,
+        }
+    }
+
+    /// True when some object's interior scatters (a scattering medium).
+    #[inline]
+    pub fn has_scattering(&self) -> bool {
+        self.scattering
+    }
+
     /// True when the scene has an environment.
     #[inline]
     pub fn has_environment(&self) -> bool {
@@ -252,6 +272,11 @@ impl Scene {
     ) -> Option<Clear<'_>> {
         let (ray, t_max) = Ray::spawn_to(p, n, to, to_n);
         match volumes {
+            Some(stack) if self.interfaces => {
+                return self.through_interfaces(ray, t_max, *stack, to, to_n).map(|tau| {
+                    if tau.is_black() { Clear::In { medium: None, length: 0.0 } } else { Clear::Through(tau) }
+                });
+            }
             Some(stack) if self.nested => {
                 if !self.clear_through_volumes(ray, t_max, *stack, to, to_n) {
                     return None;
@@ -264,7 +289,46 @@ impl Scene {
             }
         }
         let medium = volumes.and_then(|v| self.medium_in(v.current()));
-        Some(Clear { medium, length: if medium.is_some() { (to - p).length() } else { 0.0 } })
+        Some(Clear::In { medium, length: if medium.is_some() { (to - p).length() } else { 0.0 } })
+    }
+
+    /// [`Scene::transmittance`] in a scene with index-matched boundaries
+    /// (`Interface` objects): the segment passes false intersections and
+    /// `Interface` surfaces (whose crossing changes the medium: the current
+    /// one fills each piece), stops at any other surface; the answer is the
+    /// optical depth `Σ σt d` of the pieces per bin.
+    #[inline(never)]
+    fn through_interfaces(
+        &self,
+        mut ray: Ray,
+        mut t_max: f32,
+        mut stack: VolumeStack,
+        to: Vec3,
+        to_n: Vec3,
+    ) -> Option<Spectrum> {
+        let mut tau = Spectrum::ZERO;
+        let mut from = ray.origin;
+        let mut passes = 0;
+        while let Some(si) = self.intersect(&ray, t_max) {
+            let entering = ray.dir.dot(si.hit.n) < 0.0;
+            let v = self.volume(si.object)?;
+            let crossing = stack.crossing(v, entering);
+            let interface = self.bsdf(si.object).is_interface();
+            if passes >= MAX_PASSES || !(crossing == Crossing::Pass || interface) {
+                return None;
+            }
+            if let Some(m) = self.medium_in(stack.current()) {
+                tau += *m.sigma_t() * (si.hit.p - from).length();
+            }
+            from = si.hit.p;
+            stack.cross(v, entering);
+            passes += 1;
+            (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to, to_n);
+        }
+        if let Some(m) = self.medium_in(stack.current()) {
+            tau += *m.sigma_t() * (to - from).length();
+        }
+        Some(tau)
     }
 
     /// [`Scene::transmittance`]'s walk through nested volumes: passes false
@@ -294,28 +358,40 @@ impl Scene {
     }
 }
 
-/// A clear segment (see [`Scene::transmittance`]): the medium that fills it
-/// (`None`: vacuum or a clear volume) and its length.
+/// A clear segment (see [`Scene::transmittance`]).
 #[derive(Clone, Copy, Debug)]
-pub struct Clear<'a> {
-    /// What fills the segment.
-    pub medium: Option<&'a Medium>,
-    /// Its length (0 when `medium` is `None`: not computed).
-    pub length: f32,
+pub enum Clear<'a> {
+    /// One medium fills the whole segment (`None`: vacuum or a clear volume),
+    /// over its length (0 when `medium` is `None`: not computed). The common
+    /// case: two words.
+    In {
+        /// What fills the segment.
+        medium: Option<&'a Medium>,
+        /// Its length.
+        length: f32,
+    },
+    /// The segment crossed index-matched boundaries: its optical depth
+    /// `Σ σt d` per bin over the media it ran in.
+    Through(Spectrum),
 }
 
 impl Clear<'_> {
     /// Multiplies `f` by the segment's transmittance at `lambdas` (nothing in vacuum).
     #[inline(always)]
     pub fn attenuate<const N: usize>(self, f: &mut Sampled<N>, lambdas: &Lambdas<N>) {
-        if let Some(m) = self.medium {
-            *f *= m.transmittance(self.length, lambdas);
+        match self {
+            Clear::In { medium: Some(m), length } => *f *= m.transmittance(length, lambdas),
+            Clear::In { medium: None, .. } => {}
+            Clear::Through(tau) => *f *= (lambdas.sample(&tau) * -1.0).exp(),
         }
     }
 
     /// The transmittance at every bin, `None` where it is 1 (vacuum).
     #[inline]
     pub fn spectrum(self) -> Option<Spectrum> {
-        self.medium.map(|m| m.transmittance(self.length, &Lambdas::full()))
+        match self {
+            Clear::In { medium, length } => medium.map(|m| m.transmittance(length, &Lambdas::full())),
+            Clear::Through(tau) => Some((tau * -1.0).exp()),
+        }
     }
 }

@@ -84,7 +84,7 @@ impl Walk {
             let mut outside_material = None;
             if let Some(m) = scene.volume(si.object) {
                 let entering = ray.dir.dot(hit.n) < 0.0;
-                match media.crossing(m, entering) {
+                match scene.crossing(&media, m, entering) {
                     Crossing::Pass => {
                         media.cross(m, entering);
                         passes += 1;
