@@ -1094,3 +1094,47 @@ fn bad_textures_are_one_error_and_odd_ones_render() {
         assert!(o.status.success(), "{refl} {env}: {}", stderr(&o));
     }
 }
+
+/// Bad media: one error line naming the field.
+#[test]
+fn bad_media_are_one_error_naming_the_field() {
+    let dir = temp_dir("hostile_media");
+    let scene = |medium: &str, object: &str| {
+        format!(
+            r#"(camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40), render: (width: 8, height: 8, spp: 1),
+            media: {{ "m": {medium} }},
+            materials: {{ "b": Interface, "white": Lambertian(reflectance: Constant(0.5)),
+                          "tinted": Dielectric(ior: Constant(1.5), absorption: Constant(1)) }},
+            objects: [ {object} ],
+            environment: Uniform(Constant(1)))"#
+        )
+    };
+    let sphere = |material: &str, interior: &str| {
+        format!(r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "{material}", interior: "{interior}")"#)
+    };
+    let good = "Homogeneous(sigma_a: Constant(0.1), sigma_s: Constant(1))";
+    let out = dir.join("out.png");
+    for (medium, object, field, what) in [
+        (good, sphere("b", "fog"), "objects[0].interior", "unknown medium \"fog\""),
+        (good, sphere("white", "m"), "objects[0].interior", "Dielectric or an Interface"),
+        (good, sphere("tinted", "m"), "objects[0].interior", "absorption"),
+        ("Homogeneous(sigma_a: Constant(-1), sigma_s: Constant(1))", sphere("b", "m"), "media.\"m\".sigma_a", ""),
+        ("Homogeneous(sigma_a: Constant(0), sigma_s: Constant(NaN))", sphere("b", "m"), "media.\"m\".sigma_s", ""),
+        ("Homogeneous(sigma_a: Constant(0), sigma_s: Rayleigh(-2))", sphere("b", "m"), "media.\"m\".sigma_s", ""),
+        (
+            "Homogeneous(sigma_a: Constant(0), sigma_s: Constant(1), phase: HenyeyGreenstein(g: 1))",
+            sphere("b", "m"),
+            "media.\"m\".phase.g",
+            "0.999",
+        ),
+        ("Homogeneous(sigma_a: Constant(0))", sphere("b", "m"), "sigma_s", ""),
+    ] {
+        let p = scene_in(&dir, &scene(medium, &object));
+        let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+        assert!(e.contains(field) && e.contains(what), "{medium} {object}: {e}");
+    }
+    // Twice the same medium name.
+    let p = scene_in(&dir, &scene(&format!("{good}, \"m\": {good}"), &sphere("b", "m")));
+    let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+    assert!(e.contains("duplicate medium \"m\""), "{e}");
+}

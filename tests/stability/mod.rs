@@ -15,6 +15,7 @@ mod environment;
 mod glass;
 mod lighttrace;
 mod materials;
+mod media;
 mod nested;
 mod surfaces;
 
