@@ -1133,6 +1133,28 @@ fn bad_media_are_one_error_naming_the_field() {
         let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
         assert!(e.contains(field) && e.contains(what), "{medium} {object}: {e}");
     }
+    // Grid files: missing, truncated, wrong sizes, NaN and negative densities.
+    let vol = rust_v::medium::grid::write_vol([2, 2, 2], &[0.5; 8]);
+    std::fs::write(dir.join("truncated.vol"), &vol[..vol.len() - 4]).unwrap();
+    std::fs::write(dir.join("short.vol"), &vol[..30]).unwrap();
+    std::fs::write(dir.join("nan.vol"), rust_v::medium::grid::write_vol([2, 1, 1], &[0.5, f32::NAN])).unwrap();
+    std::fs::write(dir.join("neg.vol"), rust_v::medium::grid::write_vol([2, 1, 1], &[-0.5, 1.0])).unwrap();
+    let mut oversized = vol.clone();
+    oversized[8..12].copy_from_slice(&1_000_000i32.to_le_bytes());
+    std::fs::write(dir.join("oversized.vol"), &oversized).unwrap();
+    for (file, what) in [
+        ("missing.vol", "missing.vol"),
+        ("truncated.vol", "bytes of data"),
+        ("short.vol", "48-byte"),
+        ("nan.vol", "voxel (1, 0, 0)"),
+        ("neg.vol", "voxel (0, 0, 0)"),
+        ("oversized.vol", "voxels"),
+    ] {
+        let grid = format!(r#"Grid(path: "{file}", sigma_a: Constant(0), sigma_s: Constant(1))"#);
+        let p = scene_in(&dir, &scene(&grid, &sphere("b", "m")));
+        let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+        assert!(e.contains("media.\"m\".path") && e.contains(what), "{file}: {e}");
+    }
     // Twice the same medium name.
     let p = scene_in(&dir, &scene(&format!("{good}, \"m\": {good}"), &sphere("b", "m")));
     let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);

@@ -149,8 +149,9 @@ impl PathTracer {
             //    it scatters, a distance drawn by spectral MIS, and a scattering
             //    event before the surface is a vertex of the path.
             if add_emission && let Some(medium) = scene.medium_in(w.media.current()) {
-                if medium.scatters() {
-                    let d = medium.sample_distance(hit.t, lambdas, sampler.get_1d(Dim::medium_distance(w.bounces)));
+                if medium.scatters() || medium.is_grid() {
+                    let u = sampler.get_1d(Dim::medium_distance(w.bounces));
+                    let d = medium.sample_distance_along(ray.origin, ray.dir, hit.t, lambdas, u);
                     w.beta *= d.weight;
                     if d.scattered {
                         match self.scatter_in_medium(

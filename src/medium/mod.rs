@@ -24,11 +24,18 @@
 //! shadow ray `exp(−σt d)`, exact per wavelength) and its next direction from
 //! the phase function (the BSDF slot).
 
+pub mod grid;
 pub mod nested;
 pub mod phase;
 
+pub use grid::DensityGrid;
 pub use nested::{Crossing, VOLUME_STACK_DEPTH, Volume, VolumeStack};
 pub use phase::HenyeyGreenstein;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use rand::RngExt;
 
 use crate::color::{Sampled, Spectrum};
 use crate::error::Result;
@@ -39,7 +46,11 @@ use crate::spectral::Lambdas;
 /// The medium of a description at `field` (`media."milk"`): coefficients
 /// non-negative and finite, `g` within ±[`phase::MAX_G`].
 pub(crate) fn from_desc(check: &Check, field: &str, d: &MediumDesc) -> Result<Medium> {
-    let MediumDesc::Homogeneous { sigma_a, sigma_s, phase } = d;
+    let (sigma_a, sigma_s, phase) = match d {
+        MediumDesc::Homogeneous { sigma_a, sigma_s, phase } | MediumDesc::Grid { sigma_a, sigma_s, phase, .. } => {
+            (sigma_a, sigma_s, phase)
+        }
+    };
     let sigma_a = check.spectrum(&format!("{field}.sigma_a"), sigma_a)?;
     let sigma_s = check.spectrum(&format!("{field}.sigma_s"), sigma_s)?;
     for (name, s) in [("sigma_a", &sigma_a), ("sigma_s", &sigma_s)] {
@@ -62,11 +73,22 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &MediumDesc) -> Result<Me
             *g
         }
     };
-    Ok(Medium::new(sigma_a, sigma_s, HenyeyGreenstein { g }))
+    let medium = Medium::new(sigma_a, sigma_s, HenyeyGreenstein { g });
+    Ok(match d {
+        MediumDesc::Homogeneous { .. } => medium,
+        MediumDesc::Grid { path, density_scale, .. } => {
+            let scale = check.positive(&format!("{field}.density_scale"), *density_scale)?;
+            let path_field = format!("{field}.path");
+            let (_, bytes) = check.read_input(&path_field, path)?;
+            let grid = DensityGrid::parse_vol(&bytes).map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
+            medium.with_grid(Arc::new(grid), scale)
+        }
+    })
 }
 
-/// A homogeneous medium: absorption `σa(λ)` and scattering `σs(λ)` per scene
-/// unit, and a Henyey-Greenstein phase function.
+/// A medium: absorption `σa(λ)` and scattering `σs(λ)` per scene unit, times
+/// a density that is 1 everywhere (homogeneous) or given on a voxel grid over
+/// its object's bounds, and a Henyey-Greenstein phase function.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Medium {
     sigma_a: Spectrum,
@@ -75,6 +97,24 @@ pub struct Medium {
     sigma_t: Spectrum,
     phase: HenyeyGreenstein,
     scatters: bool,
+    grid: Option<Placed>,
+}
+
+/// A density grid placed over a box: the coefficients are multiplied by
+/// `scale · density((p − min) / extent)`.
+#[derive(Clone, Debug, PartialEq)]
+struct Placed {
+    grid: Arc<DensityGrid>,
+    scale: f32,
+    min: Vec3,
+    inv_extent: Vec3,
+}
+
+impl Placed {
+    #[inline]
+    fn density(&self, p: Vec3) -> f32 {
+        self.scale * self.grid.density((p - self.min) * self.inv_extent)
+    }
 }
 
 /// Where a path's segment through a scattering medium ends ([`Medium::sample_distance`]).
@@ -98,7 +138,30 @@ impl Medium {
     /// A medium that absorbs `sigma_a`, scatters `sigma_s` (both per scene
     /// unit, per bin) with phase function `phase`.
     pub fn new(sigma_a: Spectrum, sigma_s: Spectrum, phase: HenyeyGreenstein) -> Medium {
-        Medium { sigma_t: sigma_a + sigma_s, sigma_a, sigma_s, phase, scatters: !sigma_s.is_black() }
+        Medium { sigma_t: sigma_a + sigma_s, sigma_a, sigma_s, phase, scatters: !sigma_s.is_black(), grid: None }
+    }
+
+    /// The same coefficients times `scale · grid` (not yet placed: see [`Medium::placed`]).
+    pub fn with_grid(mut self, grid: Arc<DensityGrid>, scale: f32) -> Medium {
+        self.grid = Some(Placed { grid, scale, min: Vec3::ZERO, inv_extent: Vec3::ONE });
+        self
+    }
+
+    /// This medium with its grid (if any) filling the box `min`..`max` (an object's bounds).
+    pub fn placed(&self, min: Vec3, max: Vec3) -> Medium {
+        let mut m = self.clone();
+        if let Some(p) = &mut m.grid {
+            p.min = min;
+            p.inv_extent = (max - min).max(Vec3::splat(1e-30)).recip();
+        }
+        m
+    }
+
+    /// True when the density varies (a grid): segments are tracked, not
+    /// attenuated in closed form.
+    #[inline]
+    pub fn is_grid(&self) -> bool {
+        self.grid.is_some()
     }
 
     /// The absorption coefficient.
@@ -133,11 +196,132 @@ impl Medium {
         self.scatters
     }
 
-    /// The transmittance `exp(−σt(λ) d)` of a segment of length `d`, at the
-    /// packet's wavelengths (σt interpolated at each, then exponentiated).
+    /// The transmittance `exp(−σt(λ) d)` of a segment of length `d` of a
+    /// homogeneous medium, at the packet's wavelengths (σt interpolated at
+    /// each, then exponentiated). A grid's segments go through
+    /// [`Medium::optical_depth`] instead.
     #[inline]
     pub fn transmittance<const N: usize>(&self, d: f32, lambdas: &Lambdas<N>) -> Sampled<N> {
         (lambdas.sample(&self.sigma_t) * -d).exp()
+    }
+
+    /// The optical depth per bin of the segment `from`..`to`, `−ln T` of a
+    /// ratio-tracking estimate `T` of its transmittance (Novák et al. 2014):
+    /// tentative collisions at the one majorant `max_λ σt(λ) · scale · max
+    /// density`, each multiplying bin `b`'s estimate by `1 − σt,b d(x) / μ̄`.
+    /// Unbiased per bin; its random numbers come from a generator seeded by
+    /// `seed` (derived from the path's sampler and the segment, so renders stay
+    /// deterministic). For a homogeneous medium the exact `σt d`.
+    pub fn optical_depth(&self, from: Vec3, to: Vec3, seed: u64) -> Spectrum {
+        let d = (to - from).length();
+        let Some(g) = &self.grid else {
+            return self.sigma_t * d;
+        };
+        let mu = self.sigma_t.max_value() * g.scale * g.grid.max();
+        if !(mu > 0.0) || !(d > 0.0) {
+            return Spectrum::ZERO;
+        }
+        let mut rng = rand_pcg::Pcg32::new(seed, 0xa02b_dbf7_bb3c_0a7);
+        let mut t = Spectrum::ONE;
+        let mut s = 0.0f32;
+        loop {
+            s -= (1.0 - rng.random::<f32>()).ln() / mu;
+            if s >= d {
+                break;
+            }
+            let density = g.density(from + (to - from) * (s / d));
+            for b in 0..crate::color::N_BINS {
+                t[b] *= 1.0 - self.sigma_t[b] * density / mu;
+            }
+            if t.max_value() <= 0.0 {
+                break;
+            }
+        }
+        Spectrum::from_fn(|b| if t[b] > 0.0 { -t[b].ln() } else { f32::INFINITY })
+    }
+
+    /// [`Medium::sample_distance`] for the ray from `origin` along `dir`, for
+    /// either kind of medium: in a grid, delta tracking with spectral MIS
+    /// (see [`Medium::track`]) from a generator seeded by `u` and the ray.
+    #[inline]
+    pub fn sample_distance_along<const N: usize>(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lambdas: &Lambdas<N>,
+        u: f32,
+    ) -> DistanceSample<N> {
+        match &self.grid {
+            None => self.sample_distance(t_max, lambdas, u),
+            Some(_) => {
+                let seed = (u.to_bits() as u64) << 32
+                    ^ (origin.x.to_bits() as u64).rotate_left(7)
+                    ^ (origin.y.to_bits() as u64).rotate_left(19)
+                    ^ (origin.z.to_bits() as u64).rotate_left(41)
+                    ^ dir.x.to_bits() as u64;
+                self.track(origin, dir, t_max, lambdas, u, seed)
+            }
+        }
+    }
+
+    /// Delta tracking through a grid with spectral MIS over the packet: a
+    /// wavelength `j` chosen uniformly with `u`; tentative collisions at its
+    /// majorant `μj = σt(λj) · scale · max density`; at each, a real one with
+    /// probability `d(x) / max density` (the same at every wavelength: the
+    /// density scales all of them alike). For wavelength `i` the sequence
+    /// has density `pᵢ ∝ μᵢ^K exp(−μᵢ T)` (K tentative collisions over the
+    /// distance T) and its null-scattering contribution over `pᵢ` is the
+    /// albedo `σs,i/σt,i` at a real collision and 1 otherwise, so each
+    /// wavelength's weight is that times `pᵢ / mean_m p_m` (the one-sample
+    /// balance heuristic over the packet; for a constant density it is exactly
+    /// [`Medium::sample_distance`]'s).
+    fn track<const N: usize>(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        lambdas: &Lambdas<N>,
+        u: f32,
+        seed: u64,
+    ) -> DistanceSample<N> {
+        let g = self.grid.as_ref().expect("a grid");
+        let d_max = g.scale * g.grid.max();
+        let sigma_t = lambdas.sample(&self.sigma_t);
+        let j = ((u * N as f32) as usize).min(N - 1);
+        let mu = sigma_t * d_max;
+        let mut rng = rand_pcg::Pcg32::new(seed, 0x5851_f42d_4c95_7f2d);
+        // q_m = p_m / p_j, renormalised by its largest entry as it goes.
+        let mut q = Sampled::<N>::splat(1.0);
+        let mut s = 0.0f32;
+        loop {
+            // A hero that does not interact never collides (its weights still
+            // account for the others' transmittance).
+            let dt = if mu[j] > 0.0 { -(1.0 - rng.random::<f32>()).ln() / mu[j] } else { f32::INFINITY };
+            if s + dt >= t_max {
+                let rest = t_max - s;
+                q *= Sampled::from_fn(|m| (-(mu[m] - mu[j]) * rest).exp());
+                let mean = q.average();
+                let weight = if mean > 0.0 { q / mean } else { Sampled::splat(0.0) };
+                return DistanceSample { t: t_max, weight, scattered: false };
+            }
+            s += dt;
+            q *= Sampled::from_fn(|m| mu[m] / mu[j] * (-(mu[m] - mu[j]) * dt).exp());
+            let top = q.max_value();
+            if !(top > 0.0 && top.is_finite()) {
+                return DistanceSample { t: s, weight: Sampled::splat(0.0), scattered: false };
+            }
+            q /= top;
+            let density = g.density(origin + dir * s);
+            if rng.random::<f32>() * d_max < density {
+                let mean = q.average();
+                let sigma_s = lambdas.sample(&self.sigma_s);
+                let weight = Sampled::from_fn(|m| {
+                    if sigma_t[m] > 0.0 && mean > 0.0 { sigma_s[m] / sigma_t[m] * q[m] / mean } else { 0.0 }
+                });
+                return DistanceSample { t: s, weight, scattered: true };
+            }
+        }
     }
 
     /// Samples where a path travelling `t_max` through the medium scatters
@@ -177,6 +361,44 @@ impl Medium {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Ratio tracking through a grid whose density is a linear ramp along x
+    /// (64 voxels, value (i + ½)/64: the trilinear density is x itself between
+    /// the first and last voxel centres, flat beyond) is unbiased against the
+    /// closed-form optical depth σt ∫ d(x) dx along the box's axis: the mean
+    /// of 4000 estimates of T per bin within 5 standard errors (+1e-4) of
+    /// exp(−τ), for σt from 0.4 to 3.9 across the bins (a Rayleigh-like slope).
+    #[test]
+    fn ratio_tracking_is_unbiased_on_a_linear_ramp() {
+        let n = 64usize;
+        let data: Vec<f32> = (0..n).map(|i| (i as f32 + 0.5) / n as f32).collect();
+        let grid = Arc::new(DensityGrid::new([n, 1, 1], data).unwrap());
+        let sigma_s = Spectrum::from_fn(|b| 0.3 + 0.1 * b as f32);
+        let m = Medium::new(Spectrum::splat(0.1), sigma_s, HenyeyGreenstein { g: 0.0 })
+            .with_grid(grid, 1.0)
+            .placed(Vec3::new(0.0, -1.0, -1.0), Vec3::new(2.0, 1.0, 1.0));
+        // Along x from 0 to 2 (the box is 2 long: ∫ d dx over the box doubles the unit integral).
+        let (c0, c1) = (0.5 / n as f64, 1.0 - 0.5 / n as f64);
+        let unit = (c1 * c1 - c0 * c0) / 2.0 + c0 * c0 + (1.0 - c1) * c1;
+        let (from, to) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0));
+        let runs = 4000;
+        let mut sum = vec![0.0f64; N_BINS];
+        let mut sum2 = vec![0.0f64; N_BINS];
+        for k in 0..runs {
+            let tau = m.optical_depth(from, to, k);
+            for b in 0..N_BINS {
+                let t = (-tau[b] as f64).exp();
+                sum[b] += t;
+                sum2[b] += t * t;
+            }
+        }
+        for b in 0..N_BINS {
+            let mean = sum[b] / runs as f64;
+            let se = ((sum2[b] / runs as f64 - mean * mean).max(0.0) / runs as f64).sqrt();
+            let want = (-(0.1 + 0.3 + 0.1 * b as f64) * 2.0 * unit).exp();
+            assert!((mean - want).abs() < 5.0 * se + 1e-4, "bin {b}: T = {mean} ± {se}, want {want}");
+        }
+    }
     use crate::color::N_BINS;
 
     /// Beer-Lambert per bin against `exp` written out, for the full spectrum and

@@ -176,6 +176,23 @@ pub enum MediumDesc {
         #[serde(default)]
         phase: PhaseDesc,
     },
+    /// A density on a voxel grid (Mitsuba's `.vol`, 32-bit floats, one channel)
+    /// filling the object's bounding box, times the coefficients:
+    /// `Grid(path: "smoke.vol", sigma_a: Constant(0.5), sigma_s: Constant(4), density_scale: 1, phase: Isotropic)`.
+    Grid {
+        /// The `.vol` file, relative to the scene file.
+        path: String,
+        /// Absorption coefficient per scene unit at density 1.
+        sigma_a: SpectrumDesc,
+        /// Scattering coefficient per scene unit at density 1.
+        sigma_s: SpectrumDesc,
+        /// A factor on the density (default 1).
+        #[serde(default = "one")]
+        density_scale: f32,
+        /// The phase function (default `Isotropic`).
+        #[serde(default)]
+        phase: PhaseDesc,
+    },
 }
 
 /// A medium's phase function.

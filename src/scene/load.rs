@@ -243,7 +243,18 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
                         "the material has an `absorption:` (itself an interior medium); give one or the other",
                     ));
                 }
-                Some(Box::new(m.clone()))
+                let m = if m.is_grid() {
+                    let b = shape.bounds().ok_or_else(|| {
+                        ctx.err(
+                            &field,
+                            "a Grid medium fills its object's bounds: the object must be bounded (not a Plane)",
+                        )
+                    })?;
+                    m.placed(b.min, b.max)
+                } else {
+                    m.clone()
+                };
+                Some(Box::new(m))
             }
         };
         objects.push(Object { shape, material, light, priority: o.priority, interior });
@@ -257,8 +268,16 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     if objects.is_empty() {
         return Err(ctx.err("objects", "expected at least one object"));
     }
+    if let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.is_grid()))
+        && settings.integrator == IntegratorKind::Whitted
+    {
+        return Err(ctx.err(
+            format!("objects[{i}].interior"),
+            "a Grid medium: whitted does not track media; use auto, path or spectral",
+        ));
+    }
     if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace)
-        && let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.scatters()))
+        && let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.scatters() || m.is_grid()))
     {
         return Err(ctx.err(
             format!("objects[{i}].interior"),

@@ -86,7 +86,7 @@ pub struct Scene {
     nested: bool,
     /// Some object is a dielectric ([`Scene::has_volumes`]).
     volumes: bool,
-    /// Some object's interior scatters (a path samples distances there).
+    /// Some object's interior scatters or is a grid (a path samples distances there).
     scattering: bool,
     /// Some object is an index-matched boundary (`Interface`): shadow rays
     /// pass it ([`Scene::transmittance`]).
@@ -161,7 +161,7 @@ impl Scene {
                 o.interior = Some(Box::new(Medium::absorbing(*a)));
             }
         }
-        let scattering = objects.iter().any(|o| o.interior.as_ref().is_some_and(|m| m.scatters()));
+        let scattering = objects.iter().any(|o| o.interior.as_ref().is_some_and(|m| m.scatters() || m.is_grid()));
         let interfaces = objects.iter().any(|o| materials[o.material as usize].is_interface());
         let batch = Batch::new(bounded.iter().map(|&i| (i, &objects[i as usize].shape)));
         let bvh = (batch.is_none() && bounded.len() >= BVH_MIN_OBJECTS).then(|| {

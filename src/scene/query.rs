@@ -289,6 +289,11 @@ impl Scene {
             }
         }
         let medium = volumes.and_then(|v| self.medium_in(v.current()));
+        if let Some(m) = medium
+            && m.is_grid()
+        {
+            return Some(Clear::Through(m.optical_depth(p, to, segment_seed(p, to))));
+        }
         Some(Clear::In { medium, length: if medium.is_some() { (to - p).length() } else { 0.0 } })
     }
 
@@ -318,7 +323,7 @@ impl Scene {
                 return None;
             }
             if let Some(m) = self.medium_in(stack.current()) {
-                tau += *m.sigma_t() * (si.hit.p - from).length();
+                tau += m.optical_depth(from, si.hit.p, segment_seed(from, si.hit.p));
             }
             from = si.hit.p;
             stack.cross(v, entering);
@@ -326,7 +331,7 @@ impl Scene {
             (ray, t_max) = Ray::spawn_to(si.hit.p, si.hit.n, to, to_n);
         }
         if let Some(m) = self.medium_in(stack.current()) {
-            tau += *m.sigma_t() * (to - from).length();
+            tau += m.optical_depth(from, to, segment_seed(from, to));
         }
         Some(tau)
     }
@@ -356,6 +361,18 @@ impl Scene {
         }
         true
     }
+}
+
+/// The seed of a segment's ratio tracking: a hash of its end points (a
+/// path's vertices are random, so these are too; the render stays
+/// deterministic for any thread count).
+#[inline]
+fn segment_seed(a: Vec3, b: Vec3) -> u64 {
+    let mut h = crate::io::Fnv1a::default();
+    for v in [a.x, a.y, a.z, b.x, b.y, b.z] {
+        h.write(&v.to_bits().to_le_bytes());
+    }
+    h.finish()
 }
 
 /// A clear segment (see [`Scene::transmittance`]).
