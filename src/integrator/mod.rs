@@ -257,11 +257,7 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
         Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
     };
     match settings.integrator {
-        IntegratorKind::Auto
-            if needs_bdpt(scene) && scene.camera.lens_system().is_none() && !scene.has_scattering() =>
-        {
-            f.call(&bdpt(false))
-        }
+        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => f.call(&bdpt(false)),
         IntegratorKind::Auto => f.call(&FullSpectrum(path(true))),
         IntegratorKind::Bdpt => f.call(&bdpt(false)),
         IntegratorKind::LightTrace => f.call(&bdpt(true)),
@@ -315,7 +311,7 @@ fn describe_transport(scene: &Scene) -> String {
     let s = &scene.settings;
     let dispersive = scene.has_dispersion();
     match s.integrator {
-        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() && !scene.has_scattering() => format!(
+        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => format!(
             "auto: a point, spot, distant or beam light meets a specular surface (caustics path tracing cannot find): bidirectional path tracing{}",
             if dispersive { "; the full spectrum until a subpath refracts at dispersive glass, then one wavelength" } else { ", full spectrum" }
         ),

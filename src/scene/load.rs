@@ -276,15 +276,6 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
             "a Grid medium: whitted does not track media; use auto, path or spectral",
         ));
     }
-    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace)
-        && let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.scatters() || m.is_grid()))
-    {
-        return Err(ctx.err(
-            format!("objects[{i}].interior"),
-            "a scattering medium: bdpt and lighttrace do not sample media yet (they would ignore the light it \
-             scatters); use auto, path or spectral",
-        ));
-    }
 
     let c = &desc.camera;
     let eye = ctx.vec("camera.eye", c.eye)?;

@@ -124,6 +124,12 @@ impl Scene {
         }
     }
 
+    /// The medium filling object `object`'s inside, if any.
+    #[inline]
+    pub fn interior(&self, object: u32) -> Option<&Medium> {
+        self.objects[object as usize].interior.as_deref()
+    }
+
     /// The medium filling `volume` (`None`: vacuum, or a clear volume).
     #[inline]
     pub fn medium_in(&self, volume: Option<Volume>) -> Option<&Medium> {

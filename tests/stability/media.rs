@@ -1,16 +1,13 @@
 //! Rows of the failure matrix for participating media (issue 30): σ = 0,
 //! σ huge, g = ±0.999, a light inside a medium, a camera inside a medium,
-//! and a medium inside glass inside a medium. The bidirectional methods
-//! refuse scattering media (asserted once here); every other method renders
-//! each row without NaN (`render_str` asserts it).
-
-use rust_v::settings::IntegratorKind;
+//! and a medium inside glass inside a medium. Every method renders each row
+//! without NaN (`render_str` asserts it).
 
 use super::{mean_se, method, y};
 use crate::common::render_str;
 
-/// The path-tracing methods that render media, and Whitted (attenuation only).
-const MEDIA_METHODS: [&str; 5] = ["whitted", "path", "hero", "random", "auto"];
+/// Every method; Whitted attenuates without in-scattering.
+const MEDIA_METHODS: [&str; 7] = ["whitted", "path", "hero", "random", "auto", "bdpt", "lighttrace"];
 
 fn sphere_of(medium: &str, boundary: &str, camera: &str) -> String {
     format!(
@@ -47,11 +44,17 @@ fn media_of_zero_and_huge_density() {
     let zero = sphere_of("Homogeneous(sigma_a: Constant(0), sigma_s: Constant(0))", "Interface", OUTSIDE);
     expect(&zero, 1.0, 1e-4, &MEDIA_METHODS, "σ = 0");
     let huge = sphere_of("Homogeneous(sigma_a: Constant(1e5), sigma_s: Constant(9e5))", "Interface", OUTSIDE);
-    for m in ["path", "hero", "auto"] {
+    for m in ["path", "hero", "auto", "bdpt", "lighttrace"] {
         let film = render_str(&huge, &method(m, 16, 9));
         let v = y(&film);
         // Hero packets read the flat sky with a little colour noise: up to 1.05 there.
-        let top = if m == "hero" { 1.05 } else { 1.0 + 1e-6 };
+        // Light tracing and BDPT splat: per-pixel noise around 1 on the sky (a
+        // lighttrace pixel reached 2.6 at 16 spp); only finite and non-negative there.
+        let top = match m {
+            "hero" => 1.05,
+            "bdpt" | "lighttrace" => f64::INFINITY,
+            _ => 1.0 + 1e-6,
+        };
         assert!(v.iter().all(|p| p.is_finite() && (0.0..=top).contains(p)), "σ huge, {m}: {v:?}");
         // The centre sees the sphere: far below 1 (a tenth lost per event, thousands of events).
         eprintln!("σ huge, {m}: centre {}", v[6 * 12 + 6]);
@@ -61,7 +64,10 @@ fn media_of_zero_and_huge_density() {
 
 /// g = ±0.999 (the largest accepted): a sphere of albedo 1 stays invisible, 1
 /// (5 s.e. + 0.5%: the lobes are narrow, a few paths carry long chains).
-/// Whitted attenuates by σt without in-scattering: below 1 (its documented shortfall).
+/// Whitted attenuates by σt without in-scattering: below 1 (its documented
+/// shortfall). Light tracing meets the eye's direction inside the 2.5° lobe
+/// of g = 0.999 almost never: a variance failure, 0.50 ± 0.03 at 32 spp
+/// (asserted only below 1 + 5 s.e., as the rough-glass row's).
 #[test]
 fn extreme_anisotropy_keeps_energy() {
     for g in ["0.999", "-0.999"] {
@@ -70,7 +76,10 @@ fn extreme_anisotropy_keeps_energy() {
             "Interface",
             OUTSIDE,
         );
-        expect(&scene, 1.0, 5e-3, &["path", "hero", "random", "auto"], &format!("g = {g}"));
+        expect(&scene, 1.0, 5e-3, &["path", "hero", "random", "auto", "bdpt"], &format!("g = {g}"));
+        let (lt, se) = mean_se(&y(&render_str(&scene, &method("lighttrace", 32, 9))));
+        eprintln!("g = {g}, lighttrace: Y = {lt:.5} ± {se:.5} (variance failure)");
+        assert!(lt < 1.0 + 5.0 * se, "lighttrace, g {g}: {lt}");
         let film = render_str(&scene, &method("whitted", 16, 9));
         assert!(y(&film)[6 * 12 + 6] < 0.5, "whitted ignores in-scattering");
     }
@@ -83,7 +92,7 @@ fn extreme_anisotropy_keeps_energy() {
 #[test]
 fn camera_inside_a_medium() {
     let white = sphere_of("Homogeneous(sigma_a: Constant(0), sigma_s: Constant(1.5))", "Interface", INSIDE);
-    expect(&white, 1.0, 3e-3, &["path", "hero", "random", "auto"], "camera in albedo 1");
+    expect(&white, 1.0, 3e-3, &["path", "hero", "random", "auto", "bdpt", "lighttrace"], "camera in albedo 1");
     let grey = sphere_of("Homogeneous(sigma_a: Constant(0.75), sigma_s: Constant(0.75))", "Interface", INSIDE);
     for m in ["path", "auto"] {
         let (mean, _) = mean_se(&y(&render_str(&grey, &method(m, 32, 9))));
@@ -153,20 +162,6 @@ fn a_medium_inside_glass_inside_a_medium() {
             ],
             environment: Uniform(Constant(1)))"#
         );
-        expect(&scene, 1.0, 5e-3, &["path", "hero", "auto"], &format!("medium in glass in a medium, {row}"));
-    }
-}
-
-/// `bdpt` and `lighttrace` refuse a scattering medium (they would ignore
-/// its in-scattered light); with the medium only absorbing they render it.
-#[test]
-fn bidirectional_methods_refuse_scattering_media() {
-    let scattering = sphere_of("Homogeneous(sigma_a: Constant(0), sigma_s: Constant(1))", "Interface", OUTSIDE);
-    let absorbing = sphere_of("Homogeneous(sigma_a: Constant(1), sigma_s: Constant(0))", "Interface", OUTSIDE);
-    for integrator in [IntegratorKind::Bdpt, IntegratorKind::LightTrace] {
-        let patch = rust_v::settings::SettingsPatch { integrator: Some(integrator), ..Default::default() };
-        let e = rust_v::scene::load_scene_str(&scattering, std::path::Path::new("t.ron"), &patch).unwrap_err();
-        assert!(e.to_string().contains("interior"), "{e}");
-        assert!(rust_v::scene::load_scene_str(&absorbing, std::path::Path::new("t.ron"), &patch).is_ok());
+        expect(&scene, 1.0, 5e-3, &["path", "hero", "auto", "bdpt"], &format!("medium in glass in a medium, {row}"));
     }
 }

@@ -11,8 +11,8 @@ use crate::spectral::Lambdas;
 
 use super::mis::{Overrides, mis_weight};
 use super::vertex::{
-    Contrib, Kind, Vertex, Wavelength, bsdf_at, connectible, is_dispersive, outside, pdf_at, pdf_light,
-    shading_correction, to_area,
+    Contrib, Kind, Vertex, Wavelength, bsdf_at, connectible, consistent_at, cos_at, cos_normal, is_dispersive, outside,
+    pdf_at, pdf_light, scatter_at, shading_correction, to_area,
 };
 use super::{Bdpt, Sub};
 
@@ -77,6 +77,17 @@ impl Bdpt {
                     Contrib::Full(qs.beta * bxdf.eval_within(wi, qs.sh.wo, &Lambdas::full(), out) * k)
                 }
             }
+            Kind::Medium(_) => {
+                // The phase function towards the eye (symmetric: no adjoint correction, no cosine).
+                let wi = qs.sh.frame.to_local(w);
+                if single {
+                    let one = wl.single();
+                    let f = scatter_at(scene, qs, wi, qs.sh.wo, &one.lambdas)[0];
+                    Contrib::Single(wl.at(&qs.beta, qs.collapsed) * f * importance)
+                } else {
+                    Contrib::Full(qs.beta * scatter_at(scene, qs, wi, qs.sh.wo, &Lambdas::full()) * importance)
+                }
+            }
             Kind::Camera => return None,
         };
         if is_black(&c) {
@@ -90,7 +101,9 @@ impl Bdpt {
             let eye_v = Vertex::at_point(Kind::Camera, eye, cam.forward(), Spectrum::ONE, 1.0);
             let qs_rev = to_area(scene, cam.pdf_dir_from(eye, -w), &eye_v, qs);
             let qsm_rev = match qs.kind {
-                Kind::Surface(_) if s >= 2 => pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev,
+                Kind::Surface(_) | Kind::Medium(_) if s >= 2 => {
+                    pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev
+                }
                 _ => 0.0,
             };
             mis_weight(scene, camera.v, 1, light.v, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
@@ -118,13 +131,17 @@ impl Bdpt {
             // The camera subpath escaped to the environment (its only light vertex).
             return if s == 0 { self.escaped(scene, camera, t, index, wl) } else { NONE };
         }
-        let Kind::Surface(object) = pt.kind else {
+        if !matches!(pt.kind, Kind::Surface(_) | Kind::Medium(_)) {
             return NONE;
+        }
+        let object = match pt.kind {
+            Kind::Surface(o) | Kind::Medium(o) => o,
+            _ => return NONE,
         };
         match s {
             0 => {
                 // The camera subpath ends on an emitter.
-                let Some(index) = scene.emitter(object) else {
+                let (Kind::Surface(_), Some(index)) = (pt.kind, scene.emitter(object)) else {
                     return NONE;
                 };
                 let light = scene.light(index);
@@ -160,20 +177,17 @@ impl Bdpt {
                 };
                 let light = scene.light(index);
                 let wi = pt.sh.frame.to_local(ls.wi);
-                if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
+                if !consistent_at(pt, ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
                 }
-                let mut slot = None;
-                let bxdf = bsdf_at(scene, object, pt, &mut slot);
-                let out = outside(scene, pt.outside);
-                let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
+                let k = ls.scale * cos_at(pt, wi) / (pmf * ls.pdf);
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
-                    let f = bxdf.eval_within(pt.sh.wo, wi, &one.lambdas, out)[0];
+                    let f = scatter_at(scene, pt, pt.sh.wo, wi, &one.lambdas)[0];
                     let le = light.with_radiance(ls.wi, |s| one.lambdas.sample(s)[0]);
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * le * k)
                 } else {
-                    let f = bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out);
+                    let f = scatter_at(scene, pt, pt.sh.wo, wi, &Lambdas::full());
                     light.with_radiance(ls.wi, |s| Contrib::Full(pt.beta * f * *s * k))
                 };
                 if is_black(&c) {
@@ -189,8 +203,8 @@ impl Bdpt {
                 let pdf_y = if light.is_infinite() { pmf * pdf_dir } else { pmf * pdf_pos };
                 let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pdf_y);
                 let pt_rev = pdf_light(scene, &y, pt);
-                let ptm_rev = bxdf.pdf_within(wi, pt.sh.wo, &Lambdas::full(), out) * pt.g_prev;
-                let qs_rev = to_area(scene, bxdf.pdf_within(pt.sh.wo, wi, &Lambdas::full(), out), pt, &y);
+                let ptm_rev = pdf_at(scene, pt, wi, pt.sh.wo) * pt.g_prev;
+                let qs_rev = to_area(scene, pdf_at(scene, pt, pt.sh.wo, wi), pt, &y);
                 let overrides = Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 };
                 let weight = mis_weight(scene, camera.v, t, std::slice::from_ref(&y), 1, overrides);
                 scale(c, weight, transmittance, wl)
@@ -200,9 +214,9 @@ impl Bdpt {
                 if !connectible(scene, pt) || !connectible(scene, qs) {
                     return NONE;
                 }
-                let Kind::Surface(q_object) = qs.kind else {
+                if !matches!(qs.kind, Kind::Surface(_) | Kind::Medium(_)) {
                     return NONE;
-                };
+                }
                 let d = qs.p() - pt.p();
                 let d2 = d.length_squared();
                 if d2.is_nan() || d2 <= 0.0 {
@@ -210,22 +224,22 @@ impl Bdpt {
                 }
                 let w = d / d2.sqrt();
                 let (wi_p, wi_q) = (pt.sh.frame.to_local(w), qs.sh.frame.to_local(-w));
-                if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
+                if !consistent_at(pt, w, wi_p) || !consistent_at(qs, -w, wi_q) {
                     return NONE;
                 }
-                let (mut slot_p, mut slot_q) = (None, None);
-                let (bp, bq) = (bsdf_at(scene, object, pt, &mut slot_p), bsdf_at(scene, q_object, qs, &mut slot_q));
-                let (op, oq) = (outside(scene, pt.outside), outside(scene, qs.outside));
-                let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
+                // Veach's shading-normal correction on the light side's surface (1 in a medium).
+                let correction =
+                    if matches!(qs.kind, Kind::Medium(_)) { 1.0 } else { shading_correction(&qs.sh, -w, wi_q) };
+                let k = cos_at(pt, wi_p) * cos_at(qs, wi_q) / d2 * correction;
                 let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {
                     let one = wl.single();
-                    let fp = bp.eval_within(pt.sh.wo, wi_p, &one.lambdas, op)[0];
-                    let fq = bq.eval_within(wi_q, qs.sh.wo, &one.lambdas, oq)[0];
+                    let fp = scatter_at(scene, pt, pt.sh.wo, wi_p, &one.lambdas)[0];
+                    let fq = scatter_at(scene, qs, wi_q, qs.sh.wo, &one.lambdas)[0];
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
                 } else {
                     let full = Lambdas::full();
                     let (fp, fq) =
-                        (bp.eval_within(pt.sh.wo, wi_p, &full, op), bq.eval_within(wi_q, qs.sh.wo, &full, oq));
+                        (scatter_at(scene, pt, pt.sh.wo, wi_p, &full), scatter_at(scene, qs, wi_q, qs.sh.wo, &full));
                     Contrib::Full(pt.beta * fp * fq * qs.beta * k)
                 };
                 if is_black(&c) {
@@ -237,11 +251,10 @@ impl Bdpt {
                 };
                 // The four densities the connection changes, from the local
                 // directions already at hand (`wo` points back along each subpath).
-                let full = Lambdas::full();
-                let pt_rev = bq.pdf_within(qs.sh.wo, wi_q, &full, oq) * w.dot(pt.sh.n).abs() / d2;
-                let qs_rev = bp.pdf_within(pt.sh.wo, wi_p, &full, op) * w.dot(qs.sh.n).abs() / d2;
-                let ptm_rev = bp.pdf_within(wi_p, pt.sh.wo, &full, op) * pt.g_prev;
-                let qsm_rev = bq.pdf_within(wi_q, qs.sh.wo, &full, oq) * qs.g_prev;
+                let pt_rev = pdf_at(scene, qs, qs.sh.wo, wi_q) * cos_normal(pt, w) / d2;
+                let qs_rev = pdf_at(scene, pt, pt.sh.wo, wi_p) * cos_normal(qs, w) / d2;
+                let ptm_rev = pdf_at(scene, pt, wi_p, pt.sh.wo) * pt.g_prev;
+                let qsm_rev = pdf_at(scene, qs, wi_q, qs.sh.wo) * qs.g_prev;
                 let weight = mis_weight(scene, camera.v, t, light.v, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
                 scale(c, weight, transmittance, wl)
             }

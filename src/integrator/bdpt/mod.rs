@@ -192,12 +192,18 @@ impl Estimator for Bdpt {
             } else if scene.has_environment() {
                 // Light tracing cannot reach the eye from infinity: the environment
                 // seen directly is the pixel ray's, unweighted (the only strategy).
+                // Through index-matched boundaries and false intersections, attenuated by
+                // the media on the way (the one visibility rule).
                 let ray = camera_ray(scene, film, sampler);
-                if scene.intersect(&ray, f32::INFINITY).is_none()
-                    && scene.medium_in(scene.camera_volumes.current()).is_none()
-                    && let Some((_, le)) = scene.escaped(ray.dir)
+                let far = ray.origin + ray.dir * (4.0 * scene.radius() + (ray.origin - scene.camera.eye()).length());
+                let volumes = scene.has_volumes().then_some(&scene.camera_volumes);
+                if let Some((_, le)) = scene.escaped(ray.dir)
+                    && let Some(clear) = scene.transmittance(ray.origin, Vec3::ZERO, volumes, far, -ray.dir)
                 {
-                    l += le;
+                    l += match clear.spectrum() {
+                        Some(t) => le * t,
+                        None => le,
+                    };
                 }
             }
             self.light_subpath(scene, sampler, light, track.then_some(&mut *light_media), &mut wl);
