@@ -230,3 +230,35 @@ fn bidirectional_methods_render_media() {
         }
     }
 }
+
+/// Single scattering in an optically thin slab against its closed form: an
+/// index-matched slab of thickness h (σs 0.02, σa 0.01, isotropic; optical
+/// thickness 0.03 along the view) lit by a distant light of irradiance E at
+/// incidence μi = cos 60°, seen straight down (μv = 1) with nothing below:
+/// L = σs p E / μv · (1 − exp(−σt h (1/μi + 1/μv))) / (σt (1/μi + 1/μv)),
+/// p = 1/4π. Multiple scattering adds at most about the albedo times the
+/// largest optical thickness a path crosses (2/3 · (0.06 + 0.03): 6%), so
+/// the image mean (path and bdpt, 1024 spp) must lie within [L, 1.06 L]
+/// widened by 5 standard errors.
+#[test]
+fn a_thin_slab_matches_single_scattering() {
+    let (sigma_s, sigma_a, h, e) = (0.02f64, 0.01f64, 1.0f64, 50.0f64);
+    let scene = format!(
+        r#"(camera: (eye: (0, 3, 0), look_at: (0, 0, 0), up: (0, 0, -1), fov_deg: 10),
+        render: (width: 16, height: 16, spp: 1024, max_bounces: 16),
+        media: {{ "m": Homogeneous(sigma_a: Constant({sigma_a}), sigma_s: Constant({sigma_s})) }},
+        materials: {{ "b": Interface }},
+        objects: [ (shape: Cuboid(min: (-50, -{h}, -50), max: (50, 0, 50)), material: "b", interior: "m") ],
+        lights: [ Distant(direction: (0.8660254, -0.5, 0), irradiance: Constant({e})) ])"#
+    );
+    let (mu_i, mu_v) = (0.5f64, 1.0f64);
+    let sigma_t = sigma_s + sigma_a;
+    let k = 1.0 / mu_i + 1.0 / mu_v;
+    let want = sigma_s / (4.0 * std::f64::consts::PI) * e / mu_v * (1.0 - (-sigma_t * h * k).exp()) / (sigma_t * k);
+    for integrator in [IntegratorKind::Path, IntegratorKind::Bdpt] {
+        let film = render_str(&scene, &SettingsPatch { integrator: Some(integrator), ..Default::default() });
+        let (mean, se) = mean_and_stderr(&film, 1);
+        eprintln!("thin slab, {integrator:?}: Y = {mean:.6} ± {se:.6}, single scattering {want:.6}");
+        assert!(mean > want - 5.0 * se && mean < 1.06 * want + 5.0 * se, "{integrator:?}: {mean} vs {want}");
+    }
+}
