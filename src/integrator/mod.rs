@@ -99,7 +99,7 @@ impl Transport {
     }
 
     /// Radiance along `ray` for the packet `lambdas`, as XYZ.
-    #[inline]
+    #[inline(always)]
     pub fn li<const N: usize, O: Contribution>(
         &self,
         scene: &Scene,
@@ -241,7 +241,7 @@ fn one_wavelength<O: Contribution>(u: f32) -> Lambdas<1> {
 
 /// The camera ray through film position `film`: with a thin lens, through
 /// the lens point of a [`Dim::LENS`] draw; a pinhole draws nothing.
-#[inline]
+#[inline(always)]
 pub(crate) fn camera_ray(scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Ray {
     let cam = &scene.camera;
     if cam.has_lens() { cam.ray_through(film, sampler.get_2d(Dim::LENS)) } else { cam.ray(film) }

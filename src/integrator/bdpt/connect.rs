@@ -12,7 +12,7 @@ use crate::spectral::Lambdas;
 use super::mis::{Overrides, mis_weight};
 use super::vertex::{
     Contrib, Kind, Vertex, Wavelength, bsdf_at, connectible, consistent_at, cos_at, cos_normal, is_dispersive, outside,
-    pdf_at, pdf_light, scatter_at, shading_correction, to_area,
+    pdf_at, pdf_light, scatter, shading_correction, to_area,
 };
 use super::{Bdpt, Sub};
 
@@ -80,12 +80,16 @@ impl Bdpt {
             Kind::Medium(_) => {
                 // The phase function towards the eye (symmetric: no adjoint correction, no cosine).
                 let wi = qs.sh.frame.to_local(w);
+                let mut slot = None;
+                let Some(sc) = scatter(scene, qs, &mut slot) else {
+                    return None;
+                };
                 if single {
                     let one = wl.single();
-                    let f = scatter_at(scene, qs, wi, qs.sh.wo, &one.lambdas)[0];
+                    let f = sc.eval(wi, qs.sh.wo, &one.lambdas)[0];
                     Contrib::Single(wl.at(&qs.beta, qs.collapsed) * f * importance)
                 } else {
-                    Contrib::Full(qs.beta * scatter_at(scene, qs, wi, qs.sh.wo, &Lambdas::full()) * importance)
+                    Contrib::Full(qs.beta * sc.eval(wi, qs.sh.wo, &Lambdas::full()) * importance)
                 }
             }
             Kind::Camera => return None,
@@ -180,14 +184,18 @@ impl Bdpt {
                 if !consistent_at(pt, ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
                 }
+                let mut slot = None;
+                let Some(sc) = scatter(scene, pt, &mut slot) else {
+                    return NONE;
+                };
                 let k = ls.scale * cos_at(pt, wi) / (pmf * ls.pdf);
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
-                    let f = scatter_at(scene, pt, pt.sh.wo, wi, &one.lambdas)[0];
+                    let f = sc.eval(pt.sh.wo, wi, &one.lambdas)[0];
                     let le = light.with_radiance(ls.wi, |s| one.lambdas.sample(s)[0]);
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * le * k)
                 } else {
-                    let f = scatter_at(scene, pt, pt.sh.wo, wi, &Lambdas::full());
+                    let f = sc.eval(pt.sh.wo, wi, &Lambdas::full());
                     light.with_radiance(ls.wi, |s| Contrib::Full(pt.beta * f * *s * k))
                 };
                 if is_black(&c) {
@@ -202,9 +210,10 @@ impl Bdpt {
                 let (pdf_pos, pdf_dir) = light.pdf_le(ls.n, -ls.wi);
                 let pdf_y = if light.is_infinite() { pmf * pdf_dir } else { pmf * pdf_pos };
                 let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pdf_y);
+                let full = Lambdas::full();
                 let pt_rev = pdf_light(scene, &y, pt);
-                let ptm_rev = pdf_at(scene, pt, wi, pt.sh.wo) * pt.g_prev;
-                let qs_rev = to_area(scene, pdf_at(scene, pt, pt.sh.wo, wi), pt, &y);
+                let ptm_rev = sc.pdf(wi, pt.sh.wo, &full) * pt.g_prev;
+                let qs_rev = to_area(scene, sc.pdf(pt.sh.wo, wi, &full), pt, &y);
                 let overrides = Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 };
                 let weight = mis_weight(scene, camera.v, t, std::slice::from_ref(&y), 1, overrides);
                 scale(c, weight, transmittance, wl)
@@ -231,15 +240,18 @@ impl Bdpt {
                 let correction =
                     if matches!(qs.kind, Kind::Medium(_)) { 1.0 } else { shading_correction(&qs.sh, -w, wi_q) };
                 let k = cos_at(pt, wi_p) * cos_at(qs, wi_q) / d2 * correction;
+                let (mut slot_p, mut slot_q) = (None, None);
+                let (Some(sp), Some(sq)) = (scatter(scene, pt, &mut slot_p), scatter(scene, qs, &mut slot_q)) else {
+                    return NONE;
+                };
                 let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {
                     let one = wl.single();
-                    let fp = scatter_at(scene, pt, pt.sh.wo, wi_p, &one.lambdas)[0];
-                    let fq = scatter_at(scene, qs, wi_q, qs.sh.wo, &one.lambdas)[0];
+                    let fp = sp.eval(pt.sh.wo, wi_p, &one.lambdas)[0];
+                    let fq = sq.eval(wi_q, qs.sh.wo, &one.lambdas)[0];
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
                 } else {
                     let full = Lambdas::full();
-                    let (fp, fq) =
-                        (scatter_at(scene, pt, pt.sh.wo, wi_p, &full), scatter_at(scene, qs, wi_q, qs.sh.wo, &full));
+                    let (fp, fq) = (sp.eval(pt.sh.wo, wi_p, &full), sq.eval(wi_q, qs.sh.wo, &full));
                     Contrib::Full(pt.beta * fp * fq * qs.beta * k)
                 };
                 if is_black(&c) {
@@ -251,10 +263,11 @@ impl Bdpt {
                 };
                 // The four densities the connection changes, from the local
                 // directions already at hand (`wo` points back along each subpath).
-                let pt_rev = pdf_at(scene, qs, qs.sh.wo, wi_q) * cos_normal(pt, w) / d2;
-                let qs_rev = pdf_at(scene, pt, pt.sh.wo, wi_p) * cos_normal(qs, w) / d2;
-                let ptm_rev = pdf_at(scene, pt, wi_p, pt.sh.wo) * pt.g_prev;
-                let qsm_rev = pdf_at(scene, qs, wi_q, qs.sh.wo) * qs.g_prev;
+                let full = Lambdas::full();
+                let pt_rev = sq.pdf(qs.sh.wo, wi_q, &full) * cos_normal(pt, w) / d2;
+                let qs_rev = sp.pdf(pt.sh.wo, wi_p, &full) * cos_normal(qs, w) / d2;
+                let ptm_rev = sp.pdf(wi_p, pt.sh.wo, &full) * pt.g_prev;
+                let qsm_rev = sq.pdf(wi_q, qs.sh.wo, &full) * qs.g_prev;
                 let weight = mis_weight(scene, camera.v, t, light.v, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
                 scale(c, weight, transmittance, wl)
             }

@@ -253,24 +253,42 @@ pub(super) fn medium_vertex(object: u32, p: Vec3, dir: Vec3, beta: Spectrum, col
     }
 }
 
-/// What a vertex that scatters does between local directions `wo` and `wi`
-/// for the packet: its BSDF on a surface (its texture evaluated), its phase
-/// function in a medium. Zero for light and eye vertices.
-#[inline]
-pub(super) fn scatter_at<const N: usize>(
-    scene: &Scene,
-    v: &Vertex,
-    wo: Vec3,
-    wi: Vec3,
-    lambdas: &Lambdas<N>,
-) -> crate::color::Sampled<N> {
-    match v.kind {
-        Kind::Surface(o) => {
-            let mut slot = None;
-            bsdf_at(scene, o, v, &mut slot).eval_within(wo, wi, lambdas, outside(scene, v.outside))
+/// How a scattering vertex scatters: its BSDF (texture evaluated) and the
+/// medium outside a dielectric, or its phase function. Built once per
+/// vertex and connection, so a connection evaluates each end's model once.
+#[derive(Clone, Copy)]
+pub(super) enum Scatter<'a> {
+    Surface(&'a Bxdf, Outside<'a>),
+    Medium(&'a crate::medium::HenyeyGreenstein),
+}
+
+impl Scatter<'_> {
+    /// The model's value between local directions `wo` and `wi`.
+    #[inline]
+    pub(super) fn eval<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> crate::color::Sampled<N> {
+        match self {
+            Scatter::Surface(b, out) => b.eval_within(wo, wi, lambdas, *out),
+            Scatter::Medium(p) => crate::color::Sampled::splat(p.eval(wo, wi)),
         }
-        Kind::Medium(o) => crate::color::Sampled::splat(scene.interior(o).map_or(0.0, |m| m.phase().eval(wo, wi))),
-        _ => crate::color::Sampled::splat(0.0),
+    }
+
+    /// Its density for `wi` given `wo` (the full spectrum's, as the walks sample).
+    #[inline]
+    pub(super) fn pdf(&self, wo: Vec3, wi: Vec3, full: &Lambdas<N_BINS>) -> f32 {
+        match self {
+            Scatter::Surface(b, out) => b.pdf_within(wo, wi, full, *out),
+            Scatter::Medium(p) => p.eval(wo, wi),
+        }
+    }
+}
+
+/// The [`Scatter`] of surface or medium vertex `v` (a textured BSDF is built in `slot`).
+#[inline]
+pub(super) fn scatter<'s>(scene: &'s Scene, v: &Vertex, slot: &'s mut Option<Bxdf>) -> Option<Scatter<'s>> {
+    match v.kind {
+        Kind::Surface(o) => Some(Scatter::Surface(bsdf_at(scene, o, v, slot), outside(scene, v.outside))),
+        Kind::Medium(o) => scene.interior(o).map(|m| Scatter::Medium(m.phase())),
+        _ => None,
     }
 }
 
