@@ -292,6 +292,13 @@ pub fn needs_bdpt(scene: &Scene) -> bool {
 /// scene and why (printed once by `rust-v render`).
 pub fn describe(scene: &Scene) -> String {
     let line = describe_transport(scene);
+    let line = if !scene.has_scattering() {
+        line
+    } else if scene.settings.integrator == IntegratorKind::Whitted {
+        format!("{line}; participating media attenuate only (no in-scattering)")
+    } else {
+        format!("{line}; participating media: distances by spectral MIS over the wavelengths, scattering events as path vertices")
+    };
     match scene.camera.lens_system() {
         Some(lens) if lens.is_dispersive() => match scene.settings.integrator {
             IntegratorKind::Auto => format!(
