@@ -45,9 +45,9 @@ pub enum Texture {
     /// Two reflectances in a checkerboard over (u, v).
     Checkerboard {
         /// Where `⌊N u⌋ + ⌊N v⌋` is even.
-        even: Spectrum,
+        even: Box<Spectrum>,
         /// Where it is odd.
-        odd: Spectrum,
+        odd: Box<Spectrum>,
         /// Squares per unit of u and of v.
         scale: f32,
     },
@@ -75,7 +75,7 @@ impl Texture {
         match self {
             Texture::Checkerboard { even, odd, scale } => {
                 let (i, j) = ((uv.x * scale).floor() as i64, (uv.y * scale).floor() as i64);
-                if (i + j).rem_euclid(2) == 0 { *even } else { *odd }
+                if (i + j).rem_euclid(2) == 0 { **even } else { **odd }
             }
             Texture::Image(image) => image.eval(uv),
         }
@@ -177,8 +177,8 @@ fn fit_rows(width: usize, rgb: &[[f32; 3]], scale: f32) -> Vec<Uplift> {
 pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
     Ok(Some(match d {
         SpectrumDesc::Checkerboard { even, odd, scale } => Texture::Checkerboard {
-            even: check.reflectance(&format!("{field}.even"), even)?,
-            odd: check.reflectance(&format!("{field}.odd"), odd)?,
+            even: Box::new(check.reflectance(&format!("{field}.even"), even)?),
+            odd: Box::new(check.reflectance(&format!("{field}.odd"), odd)?),
             scale: check.positive(&format!("{field}.scale"), *scale)?,
         },
         SpectrumDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
@@ -266,7 +266,11 @@ mod tests {
     /// The checkerboard's squares.
     #[test]
     fn checkerboard_squares() {
-        let t = Texture::Checkerboard { even: Spectrum::splat(0.8), odd: Spectrum::splat(0.1), scale: 4.0 };
+        let t = Texture::Checkerboard {
+            even: Box::new(Spectrum::splat(0.8)),
+            odd: Box::new(Spectrum::splat(0.1)),
+            scale: 4.0,
+        };
         assert_eq!(t.eval(Vec2::new(0.1, 0.1))[0], 0.8);
         assert_eq!(t.eval(Vec2::new(0.3, 0.1))[0], 0.1);
         assert_eq!(t.eval(Vec2::new(0.3, 0.3))[0], 0.8);

@@ -297,7 +297,9 @@ pub fn describe(scene: &Scene) -> String {
     } else if scene.settings.integrator == IntegratorKind::Whitted {
         format!("{line}; participating media attenuate only (no in-scattering)")
     } else {
-        format!("{line}; participating media: distances by spectral MIS over the wavelengths, scattering events as path vertices")
+        format!(
+            "{line}; participating media: distances by spectral MIS over the wavelengths, scattering events as path vertices"
+        )
     };
     match scene.camera.lens_system() {
         Some(lens) if lens.is_dispersive() => match scene.settings.integrator {
@@ -529,7 +531,7 @@ pub(crate) fn sample_direct_medium<const N: usize>(
     };
     let ls = choice.sample;
     let f = phase.eval(wo, ls.wi);
-    if !(f > 0.0) {
+    if f.is_nan() || f <= 0.0 {
         return zero;
     }
     let Some(clear) = scene.transmittance(p, Vec3::ZERO, Some(volumes), ls.point, ls.n) else {

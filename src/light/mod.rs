@@ -95,7 +95,7 @@ impl Light {
     /// The spectrum emitted: radiance for area lights, intensity for point
     /// and spot lights, irradiance for distant lights and beams; for the
     /// environment, whose radiance varies with direction, the per-bin peak
-    /// (for warnings only: a sample's radiance is [`Light::radiance`]).
+    /// (for warnings only: a sample's radiance is [`Light::with_radiance`]).
     #[inline]
     pub fn spectrum(&self) -> &Spectrum {
         match self {

@@ -218,10 +218,10 @@ impl Medium {
             return self.sigma_t * d;
         };
         let mu = self.sigma_t.max_value() * g.scale * g.grid.max();
-        if !(mu > 0.0) || !(d > 0.0) {
+        if mu.is_nan() || mu <= 0.0 || d.is_nan() || d <= 0.0 {
             return Spectrum::ZERO;
         }
-        let mut rng = rand_pcg::Pcg32::new(seed, 0xa02b_dbf7_bb3c_0a7);
+        let mut rng = rand_pcg::Pcg32::new(seed, 0x0a02_bdbf_7bb3_c0a7);
         let mut t = Spectrum::ONE;
         let mut s = 0.0f32;
         loop {
@@ -242,7 +242,7 @@ impl Medium {
 
     /// [`Medium::sample_distance`] for the ray from `origin` along `dir`, for
     /// either kind of medium: in a grid, delta tracking with spectral MIS
-    /// (see [`Medium::track`]) from a generator seeded by `u` and the ray.
+    /// (`Medium::track`) from a generator seeded by `u` and the ray.
     #[inline]
     pub fn sample_distance_along<const N: usize>(
         &self,

@@ -81,9 +81,7 @@ impl Bdpt {
                 // The phase function towards the eye (symmetric: no adjoint correction, no cosine).
                 let wi = qs.sh.frame.to_local(w);
                 let mut slot = None;
-                let Some(sc) = scatter(scene, qs, &mut slot) else {
-                    return None;
-                };
+                let sc = scatter(scene, qs, &mut slot)?;
                 if single {
                     let one = wl.single();
                     let f = sc.eval(wi, qs.sh.wo, &one.lambdas)[0];
