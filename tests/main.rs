@@ -18,6 +18,7 @@ mod lights;
 mod memory;
 mod metrics;
 mod output;
+mod pbrt;
 mod sampler;
 mod scenes;
 mod spectra;

@@ -37,13 +37,31 @@ pub fn is_pbrt(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("pbrt"))
 }
 
+/// Reads the pbrt scene file at `path` into its scene description, with the
+/// warnings (one line each); `strict` makes every warning an error. Geometry is in
+/// rust-v's world space: mirrored `x → −x` when pbrt's camera space needs it (see
+/// `docs/pbrt.md`, Handedness).
+pub fn read_pbrt(path: &Path, strict: bool) -> Result<(SceneDesc, Vec<String>)> {
+    let bytes = crate::io::read_input(path)?;
+    let text = std::str::from_utf8(bytes.strip_prefix(&[0xef, 0xbb, 0xbf]).unwrap_or(&bytes)).map_err(|e| {
+        crate::error::Error::scene_field(
+            path,
+            "",
+            format!("byte {} is not UTF-8; expected UTF-8 text", e.valid_up_to()),
+        )
+    })?;
+    let ctx = Check::new(path);
+    let imported = import(&ctx, path, text, strict)?;
+    Ok((imported.desc, imported.warnings))
+}
+
 /// Reads the pbrt scene `text` of the file `path`; files it reads are recorded in `ctx`.
 pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> Result<Imported> {
     let mut p = parser::Parser::new(ctx, path, text.to_string(), strict);
     p.run()?;
     let warnings = p.warning_lines();
     let b = std::mem::take(&mut p.built);
-    let camera = b.camera.expect("WorldBegin resolves the camera");
+    let camera = b.camera.ok_or_else(|| crate::error::Error::scene_field(path, "", "the file has no WorldBegin"))?;
     Ok(Imported {
         desc: SceneDesc {
             camera,
