@@ -71,7 +71,7 @@ fn syntax_errors_name_the_file_line_and_column() {
         ("AttributeEnd\n", "6:1", "without a matching AttributeBegin"),
         (
             "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 3]\n",
-            "6:54",
+            "6:53",
             "out of range",
         ),
         ("NamedMaterial \"nope\"\n", "6:15", "unknown material \"nope\""),
