@@ -1214,18 +1214,17 @@ impl Parser<'_> {
                 self.warn(loc, format!("Shape \"{ty}\" \"{p}\" is not supported (ignored)"))?;
             }
         }
-        let mut tris: Vec<[u32; 3]> = if corners == 4 {
+        let tris: Vec<[u32; 3]> = if corners == 4 {
             indices.chunks(4).flat_map(|q| [[q[0], q[1], q[2]], [q[2], q[1], q[3]]]).collect()
         } else {
             indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect()
         };
         if ty == "loopsubdiv" {
-            let levels = self.int(ps, "levels", 3, 0, 8)?;
-            if levels > 0 {
-                self.warn(at, "loopsubdiv: Loop subdivision is not implemented yet; the control mesh is rendered")?;
-            }
+            let levels = self.int(ps, "levels", 3, 0, 6)?;
+            let (p, t, n) = super::loop_subdiv::subdivide(positions, tris, levels as u32);
+            let n = n.iter().all(|v| *v != DVec3::ZERO).then_some(n);
+            return Ok((p, t, n, None));
         }
-        tris.shrink_to_fit();
         Ok((positions, tris, normals, uvs))
     }
 }

@@ -10,6 +10,7 @@
 //! message with a count of further uses), or with `strict` an error.
 
 mod lexer;
+mod loop_subdiv;
 mod map;
 mod parser;
 mod write;
