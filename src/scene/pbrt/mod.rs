@@ -1,8 +1,8 @@
 //! pbrt-v4 scene files (`.pbrt`): a second reader of the format-neutral scene
-//! description. [`lexer`] makes tokens, [`parser`] reads directives, parameter
+//! description. `lexer` makes tokens, `parser` reads directives, parameter
 //! lists, the graphics state and transforms (with `Include`/`Import`), and
-//! [`map`] turns each pbrt entity into its [`SceneDesc`] counterpart; the
-//! scene is then built exactly like a RON scene. [`write`] is `rust-v convert`:
+//! `map` turns each pbrt entity into its [`SceneDesc`] counterpart; the
+//! scene is then built exactly like a RON scene. `write` is `rust-v convert`:
 //! the same description written as RON.
 //!
 //! What is supported, mapped, warned about and refused is in `docs/pbrt.md`.
