@@ -344,7 +344,7 @@ fn unsupported_things_warn_once_with_a_count_and_strict_makes_them_errors() {
     );
     assert!(
         warnings[1].contains("s.pbrt:7:16:")
-            && warnings[1].contains("\"float radiuss\"")
+            && warnings[1].contains("\"float radiuss\" is not supported (ignored); read here: alpha, emissionfilename, phimax, radius, zmax, zmin")
             && warnings[1].ends_with("(and 2 more)"),
         "{warnings:?}"
     );

@@ -163,6 +163,7 @@ impl Parser<'_> {
 
     /// The parameter `name`, marked as read.
     fn param<'p>(&self, ps: &'p Params, name: &str) -> Option<&'p Param> {
+        ps.1.borrow_mut().push(name.to_string());
         let p = ps.0.iter().find(|p| p.name == name)?;
         p.used.set(true);
         Some(p)
@@ -361,7 +362,7 @@ impl Parser<'_> {
     /// remapped as pbrt-v4 does (α = √r) unless `remaproughness` is false.
     fn roughness(&mut self, ps: &Params, prefix: &str, loc: Loc) -> Result<f32> {
         let n = |s: &str| format!("{prefix}{s}");
-        let r = if ps.0.iter().any(|p| p.name == n("roughness")) {
+        let r = if self.param(ps, &n("roughness")).is_some() {
             self.float_or_texture(ps, &n("roughness"), 0.0)?
         } else {
             let u = self.float_or_texture(ps, &n("uroughness"), 0.0)?;
@@ -959,7 +960,12 @@ impl Parser<'_> {
             "sphere" | "disk" => {
                 let s = self.uniform_scale(lin, at, &rec.ty)?;
                 let radius = self.float(ps, "radius", 1.0)?;
-                for (p, full) in [("zmin", None), ("zmax", None), ("phimax", Some(360.0)), ("innerradius", Some(0.0))] {
+                let cuts: &[(&str, Option<f64>)] = if rec.ty == "sphere" {
+                    &[("zmin", None), ("zmax", None), ("phimax", Some(360.0))]
+                } else {
+                    &[("phimax", Some(360.0)), ("innerradius", Some(0.0))]
+                };
+                for &(p, full) in cuts {
                     if let Some(q) = self.param(ps, p) {
                         let v = self.nums_of(q, &["float"])?[0];
                         let partial = match (p, full) {

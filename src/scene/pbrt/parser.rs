@@ -49,7 +49,7 @@ pub(crate) struct Param {
 
 /// A directive's parameter list.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Params(pub(crate) Vec<Param>);
+pub(crate) struct Params(pub(crate) Vec<Param>, pub(crate) std::cell::RefCell<Vec<String>>);
 
 const NUMERIC_TYPES: [&str; 13] = [
     "integer",
@@ -643,6 +643,7 @@ impl<'c> Parser<'c> {
                         if let Some(p) = ps.0.iter().find(|p| p.name == "type") {
                             p.used.set(true);
                         }
+                        ps.1.borrow_mut().push("type".into());
                         s[0].clone()
                     }
                     _ => {
@@ -729,9 +730,16 @@ impl<'c> Parser<'c> {
 
     /// Warns about every parameter of `ps` that nothing read: `what` names the entity.
     pub(crate) fn check_used(&mut self, ps: &Params, what: &str) -> Result<()> {
+        let mut known: Vec<String> = ps.1.borrow().clone();
+        known.sort();
+        known.dedup();
+        let known = if known.is_empty() { "none".to_string() } else { known.join(", ") };
         for p in &ps.0 {
             if !p.used.get() {
-                self.warn(p.loc, format!("{what}: parameter \"{} {}\" is not supported (ignored)", p.ty, p.name))?;
+                self.warn(
+                    p.loc,
+                    format!("{what}: parameter \"{} {}\" is not supported (ignored); read here: {known}", p.ty, p.name),
+                )?;
             }
         }
         Ok(())
