@@ -544,3 +544,35 @@ fn a_killeroo_like_scene_loads_without_unexpected_warnings_and_renders() {
         s => panic!("{s:?}"),
     }
 }
+
+#[test]
+fn one_sided_emitters_face_where_pbrt_says() {
+    // pbrt-v4: a triangle's normal is (p0 − p2) × (p1 − p2) in world space, flipped by
+    // ReverseOrientation and again by a transform that swaps handedness (so a mirror
+    // keeps the object-space side). This quad's normal is −y by hand:
+    // ((0.5, 0, 0) × (0.5, 0, 0.5)) = (0, −0.25, 0), towards the floor. The camera sees
+    // the floor, not the light (21° above its view direction, outside the 15° half-angle).
+    let d = temp_dir("pbrt-sides");
+    let floor_light = |extra: &str| {
+        let p = write(
+            &d,
+            "s.pbrt",
+            &format!(
+                "LookAt 0 0.8 4  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 30\nWorldBegin\n\
+                 Shape \"trianglemesh\" \"point3 P\" [ -2 0 -2  -2 0 2  2 0 2  2 0 -2 ] \"integer indices\" [ 0 1 2 0 2 3 ]\n\
+                 AttributeBegin\n {extra}\n AreaLightSource \"diffuse\" \"rgb L\" [ 4 4 4 ]\n\
+                 Shape \"trianglemesh\" \"point3 P\" [ -0.25 1.5 -0.25  0.25 1.5 -0.25  0.25 1.5 0.25  -0.25 1.5 0.25 ]\n\
+                 \"integer indices\" [ 0 1 2 0 2 3 ]\nAttributeEnd\n"
+            ),
+        );
+        let film = film_of(&load_scene(&p, &small()).unwrap());
+        film.mean_xyz().iter().map(|p| p[1]).sum::<f64>()
+    };
+    assert!(floor_light("") > 0.1, "the light faces the floor");
+    // Reversed it faces up: nothing is lit (up to rounding: 4e-14 was measured; the lit
+    // floor sums to more than 0.1).
+    let reversed = floor_light("ReverseOrientation");
+    assert!(reversed < 1e-9, "reversed, it faces the ceiling: nothing is lit, found {reversed}");
+    assert!(floor_light("Scale -1 1 1") > 0.1, "a mirror keeps the side");
+    assert!(floor_light("Scale -1 1 1\n ReverseOrientation") < 1e-9);
+}
