@@ -576,3 +576,40 @@ fn one_sided_emitters_face_where_pbrt_says() {
     assert!(floor_light("Scale -1 1 1") > 0.1, "a mirror keeps the side");
     assert!(floor_light("Scale -1 1 1\n ReverseOrientation") < 1e-9);
 }
+
+#[test]
+fn convert_rewrites_texture_paths_and_reads_spectrum_files() {
+    let d = temp_dir("pbrt-tex");
+    let png = std::fs::read_dir(root().join("docs/images"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "png"))
+        .expect("a PNG in docs/images");
+    std::fs::create_dir_all(d.join("tex")).unwrap();
+    std::fs::copy(&png, d.join("tex/t.png")).unwrap();
+    write(&d, "spd/green.spd", "# a green reflectance\n400 0.1\n500 0.2\n550 0.7\n600 0.2 700 0.1\n");
+    let p = write(
+        &d,
+        "s.pbrt",
+        &format!(
+            "{HEAD}LightSource \"point\" \"point3 from\" [0 0 4] \"float power\" 400\n\
+             Texture \"img\" \"spectrum\" \"imagemap\" \"string filename\" \"tex/t.png\" \"float uscale\" 2\n\
+             AttributeBegin\n Material \"diffuse\" \"texture reflectance\" \"img\"\n\
+             Shape \"trianglemesh\" \"point3 P\" [-2 -2 0  2 -2 0  2 2 0  -2 2 0] \"integer indices\" [0 1 2 0 2 3]\n\
+              \"point2 uv\" [0 0 1 0 1 1 0 1]\nAttributeEnd\n\
+             Material \"diffuse\" \"spectrum reflectance\" \"spd/green.spd\"\nShape \"sphere\" \"float radius\" 0.5\n"
+        ),
+    );
+    let scene = load_scene(&p, &small()).unwrap();
+    let names: Vec<String> =
+        scene.inputs.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert!(names.contains(&"t.png".to_string()) && names.contains(&"green.spd".to_string()), "{names:?}");
+    let ron = d.join("out/s.ron");
+    std::fs::create_dir_all(d.join("out")).unwrap();
+    let o = rust_v(&["convert", s(&p), "-o", s(&ron)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&ron).unwrap();
+    assert!(text.contains("path: \"../tex/t.png\""), "{text}");
+    assert!(text.contains("Table([(400.0, 0.1), (500.0, 0.2), (550.0, 0.7), (600.0, 0.2), (700.0, 0.1)])"), "{text}");
+    assert_same_films(&film_of(&scene), &film_of(&load_scene(&ron, &small()).unwrap()));
+}
