@@ -613,3 +613,33 @@ fn convert_rewrites_texture_paths_and_reads_spectrum_files() {
     assert!(text.contains("Table([(400.0, 0.1), (500.0, 0.2), (550.0, 0.7), (600.0, 0.2), (700.0, 0.1)])"), "{text}");
     assert_same_films(&film_of(&scene), &film_of(&load_scene(&ron, &small()).unwrap()));
 }
+
+#[test]
+fn a_real_gzipped_ply_loads_through_plymesh_and_converts() {
+    // The Stanford dragon at its coarsest resolution, when ../shared is present.
+    let Some(ply) = crate::common::shared("meshes/dragon_vrip_res4.ply.gz") else {
+        eprintln!("skipped: ../shared/meshes/dragon_vrip_res4.ply.gz is absent");
+        return;
+    };
+    let d = temp_dir("pbrt-dragon");
+    let p = write(
+        &d,
+        "dragon.pbrt",
+        &format!(
+            "LookAt 0 0.15 0.4  0 0.1 0  0 1 0\nCamera \"perspective\" \"float fov\" 35\nWorldBegin\n\
+             LightSource \"distant\" \"point3 from\" [1 1 1] \"point3 to\" [0 0 0]\n\
+             Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.05\n\
+             AttributeBegin\n Rotate 30 0 1 0\n Shape \"plymesh\" \"string filename\" \"{}\"\nAttributeEnd\n",
+            s(&ply)
+        ),
+    );
+    let (scene, w) = load_scene_with_warnings(&p, &small(), true).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let ron = d.join("dragon.ron");
+    let o = rust_v(&["convert", s(&p), "-o", s(&ron), "--strict"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(d.join("dragon-mesh-0.ply").exists());
+    let a = film_of(&scene);
+    assert_same_films(&a, &film_of(&load_scene(&ron, &small()).unwrap()));
+    assert!(a.mean_xyz().iter().map(|p| p[1]).sum::<f64>() > 0.01, "the dragon is seen and lit");
+}
