@@ -643,3 +643,23 @@ fn a_real_gzipped_ply_loads_through_plymesh_and_converts() {
     assert_same_films(&a, &film_of(&load_scene(&ron, &small()).unwrap()));
     assert!(a.mean_xyz().iter().map(|p| p[1]).sum::<f64>() > 0.01, "the dragon is seen and lit");
 }
+
+#[test]
+fn expansion_is_bounded() {
+    let d = temp_dir("pbrt-bounded");
+    let tri = "\"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]";
+    let p = write(&d, "sub.pbrt", &format!("{HEAD}Shape \"loopsubdiv\" \"integer levels\" 14 {tri}\n"));
+    let e = load_scene(&p, &small()).err().map(|e| e.to_string()).expect("an error");
+    assert!(e.contains("sub.pbrt:6:7:") && e.contains("268435456"), "{e}");
+    // 2^13 instances of an object of 2^13 triangles: 2^26 is the limit, one more is refused.
+    let mesh: String = (0..8192).map(|i| format!("{} 1 2 ", (i % 3))).collect::<String>();
+    let pts = "\"point3 P\" [0 0 0 1 0 0 0 1 0]";
+    let mut text =
+        format!("{HEAD}ObjectBegin \"o\"\nShape \"trianglemesh\" {pts} \"integer indices\" [ {mesh} ]\nObjectEnd\n");
+    for _ in 0..8193 {
+        text.push_str("ObjectInstance \"o\"\n");
+    }
+    let p = write(&d, "inst.pbrt", &text);
+    let e = load_scene(&p, &small()).err().map(|e| e.to_string()).expect("an error");
+    assert!(e.contains("more than 67108864 triangles"), "{e}");
+}

@@ -83,7 +83,14 @@ pub(crate) struct Built {
     pub(crate) mirror: DMat4,
     ply_cache: HashMap<String, Rc<MeshData>>,
     anonymous: usize,
+    /// Triangles placed so far (copies of instances included), against [`MAX_TRIANGLES`].
+    triangles: usize,
 }
+
+/// The most triangles a pbrt scene may expand to (instances are copies, `loopsubdiv`
+/// multiplies by 4 per level): about 1.6 GB of positions and indices at most, so a
+/// small hostile file cannot exhaust memory.
+pub(crate) const MAX_TRIANGLES: usize = 1 << 26;
 
 impl Default for Built {
     fn default() -> Self {
@@ -102,6 +109,7 @@ impl Default for Built {
             mirror: DMat4::IDENTITY,
             ply_cache: HashMap::new(),
             anonymous: 0,
+            triangles: 0,
         }
     }
 }
@@ -1051,6 +1059,13 @@ impl Parser<'_> {
                         })
                         .collect()
                 });
+                self.built.triangles += tris.len();
+                if self.built.triangles > MAX_TRIANGLES {
+                    return Err(self.err(
+                        at,
+                        format!("the scene expands to more than {MAX_TRIANGLES} triangles (instances are copies): expected fewer"),
+                    ));
+                }
                 (
                     ShapeDesc::Triangles {
                         positions: world.iter().map(|p| f3(*p)).collect(),
@@ -1226,7 +1241,14 @@ impl Parser<'_> {
             indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect()
         };
         if ty == "loopsubdiv" {
-            let levels = self.int(ps, "levels", 3, 0, 6)?;
+            let levels = self.int(ps, "levels", 3, 0, 16)?;
+            let after = tris.len().saturating_mul(1 << (2 * levels));
+            if after > MAX_TRIANGLES {
+                return Err(self.err(
+                    at,
+                    format!("loopsubdiv: {} triangles at {levels} levels make {after}, more than {MAX_TRIANGLES}: expected fewer levels", tris.len()),
+                ));
+            }
             let (p, t, n) = super::loop_subdiv::subdivide(positions, tris, levels as u32);
             let n = n.iter().all(|v| *v != DVec3::ZERO).then_some(n);
             return Ok((p, t, n, None));
