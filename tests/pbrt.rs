@@ -553,7 +553,7 @@ fn one_sided_emitters_face_where_pbrt_says() {
     // ((0.5, 0, 0) × (0.5, 0, 0.5)) = (0, −0.25, 0), towards the floor. The camera sees
     // the floor, not the light (21° above its view direction, outside the 15° half-angle).
     let d = temp_dir("pbrt-sides");
-    let floor_light = |extra: &str| {
+    let floor_light_with = |extra: &str, indices: &str, normals: &str| {
         let p = write(
             &d,
             "s.pbrt",
@@ -562,12 +562,13 @@ fn one_sided_emitters_face_where_pbrt_says() {
                  Shape \"trianglemesh\" \"point3 P\" [ -2 0 -2  -2 0 2  2 0 2  2 0 -2 ] \"integer indices\" [ 0 1 2 0 2 3 ]\n\
                  AttributeBegin\n {extra}\n AreaLightSource \"diffuse\" \"rgb L\" [ 4 4 4 ]\n\
                  Shape \"trianglemesh\" \"point3 P\" [ -0.25 1.5 -0.25  0.25 1.5 -0.25  0.25 1.5 0.25  -0.25 1.5 0.25 ]\n\
-                 \"integer indices\" [ 0 1 2 0 2 3 ]\nAttributeEnd\n"
+                 \"integer indices\" [ {indices} ] {normals}\nAttributeEnd\n"
             ),
         );
         let film = film_of(&load_scene(&p, &small()).unwrap());
         film.mean_xyz().iter().map(|p| p[1]).sum::<f64>()
     };
+    let floor_light = |extra: &str| floor_light_with(extra, "0 1 2 0 2 3", "");
     assert!(floor_light("") > 0.1, "the light faces the floor");
     // Reversed it faces up: nothing is lit (up to rounding: 4e-14 was measured; the lit
     // floor sums to more than 0.1).
@@ -575,6 +576,11 @@ fn one_sided_emitters_face_where_pbrt_says() {
     assert!(reversed < 1e-9, "reversed, it faces the ceiling: nothing is lit, found {reversed}");
     assert!(floor_light("Scale -1 1 1") > 0.1, "a mirror keeps the side");
     assert!(floor_light("Scale -1 1 1\n ReverseOrientation") < 1e-9);
+    // With shading normals pbrt faces each triangle towards them (FaceForward), whatever
+    // the winding: the reversed winding with normals pointing down still lights the floor.
+    let down = "\"normal N\" [ 0 -1 0  0 -1 0  0 -1 0  0 -1 0 ]";
+    assert!(floor_light_with("", "0 2 1 0 3 2", down) > 0.1);
+    assert!(floor_light_with("", "0 1 2 0 2 3", &down.replace("-1", "1")) < 1e-9);
 }
 
 #[test]

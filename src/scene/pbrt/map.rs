@@ -962,6 +962,9 @@ impl Parser<'_> {
         let x = self.built.mirror * instance * rec.ctm;
         let lin = DMat3::from_mat4(x);
         let flip = rec.reverse ^ (lin.determinant() < 0.0);
+        // pbrt's own `reverseOrientation ^ transformSwapsHandedness` (without the mirror `M`),
+        // which flips the normal of its quadrics at intersections.
+        let quadric_flip = rec.reverse ^ (DMat3::from_mat4(instance * rec.ctm).determinant() < 0.0);
         let what = format!("Shape \"{}\"", rec.ty);
         let mut mesh_file = None;
         let (shape, area) = match rec.ty.as_str() {
@@ -992,8 +995,8 @@ impl Parser<'_> {
                 }
                 let r = radius * s;
                 if rec.ty == "sphere" {
-                    if rec.reverse && rec.area.is_some() {
-                        self.warn(at, "ReverseOrientation on an emitting sphere: rust-v's sphere emits outwards")?;
+                    if quadric_flip && rec.area.is_some() {
+                        self.warn(at, "an emitting sphere that pbrt turns inside out (ReverseOrientation, or a mirroring transform): rust-v's sphere emits outwards")?;
                     }
                     let center = x.transform_point3(DVec3::ZERO);
                     (ShapeDesc::Sphere { center: f3(center), radius: r as f32 }, 4.0 * std::f64::consts::PI * r * r)
@@ -1001,7 +1004,7 @@ impl Parser<'_> {
                     let h = self.float(ps, "height", 0.0)?;
                     let center = x.transform_point3(DVec3::new(0.0, 0.0, h));
                     let mut n = (lin.inverse().transpose() * DVec3::Z).normalize();
-                    if rec.reverse {
+                    if quadric_flip {
                         n = -n;
                     }
                     (
@@ -1051,7 +1054,7 @@ impl Parser<'_> {
                     }
                 }
                 let nt = lin.inverse().transpose();
-                let normals = normals.map(|ns: Vec<DVec3>| {
+                let normals: Option<Vec<V3>> = normals.map(|ns: Vec<DVec3>| {
                     ns.iter()
                         .map(|n| {
                             let w = (nt * *n).normalize_or_zero();
@@ -1059,6 +1062,17 @@ impl Parser<'_> {
                         })
                         .collect()
                 });
+                // With shading normals pbrt turns each triangle's geometric normal towards
+                // them (`FaceForward`): orient the winding the same way.
+                if let Some(ns) = &normals {
+                    for t in &mut tris {
+                        let [a, b, c] = t.map(|i| world[i as usize]);
+                        let s: DVec3 = t.iter().map(|&i| DVec3::from(ns[i as usize].map(f64::from))).sum();
+                        if (b - a).cross(c - a).dot(s) < 0.0 {
+                            t.swap(1, 2);
+                        }
+                    }
+                }
                 self.built.triangles += tris.len();
                 if self.built.triangles > MAX_TRIANGLES {
                     return Err(self.err(
