@@ -591,7 +591,9 @@ impl Parser<'_> {
     // Materials and textures.
 
     /// Adds a material to the description under `name` (or a new name) and returns its reference.
-    fn add_material(&mut self, name: Option<&str>, m: MaterialDesc, at: Loc) -> Result<MatRef> {
+    /// An anonymous material (`Material "diffuse" ...`) is named `#K TYPE` (`#3 diffuse`),
+    /// K counting them: a name a pbrt file would hardly give.
+    fn add_material(&mut self, name: Option<&str>, ty: &str, m: MaterialDesc, at: Loc) -> Result<MatRef> {
         let name = match name {
             Some(n) => {
                 if self.built.materials.iter().any(|(k, _)| k == n) {
@@ -601,7 +603,7 @@ impl Parser<'_> {
             }
             None => loop {
                 self.built.anonymous += 1;
-                let n = format!("material-{}", self.built.anonymous);
+                let n = format!("#{} {ty}", self.built.anonymous);
                 if !self.built.materials.iter().any(|(k, _)| *k == n) {
                     break n;
                 }
@@ -768,7 +770,7 @@ impl Parser<'_> {
             }
         }
         self.check_used(ps, &what)?;
-        self.add_material(name, m, at)
+        self.add_material(name, ty, m, at)
     }
 
     pub(crate) fn texture(&mut self, name: String, kind: &str, class: &str, at: Loc, ps: &Params) -> Result<()> {
