@@ -660,3 +660,57 @@ fn expansion_is_bounded() {
     // (The same limit on instance copies is not tested here: reaching 2^26 triangles takes
     // about 1 GB.)
 }
+
+#[test]
+fn matrices_coordinate_systems_disks_and_spots_by_hand() {
+    let d = temp_dir("pbrt-matrices");
+    // `Transform` lists the matrix column by column (pbrt transposes what it reads): the
+    // translation is in elements 13-15. `ConcatTransform` post-multiplies: a scale by 2
+    // after the translation scales the sphere about its own centre.
+    // `CoordSysTransform "camera"` puts a shape at the eye (pbrt's "camera" system is
+    // world-from-camera), and `Translate 0 0 3` then moves it 3 along the view (+z in
+    // pbrt's camera space).
+    let p = write(
+        &d,
+        "s.pbrt",
+        "LookAt 1 2 3  1 2 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+         AttributeBegin\n Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 ]\n \
+         ConcatTransform [ 2 0 0 0  0 2 0 0  0 0 2 0  0 0 0 1 ]\n Shape \"sphere\" \"float radius\" 0.5\nAttributeEnd\n\
+         AttributeBegin\n CoordSysTransform \"camera\"\n Translate 0 0 3\n Shape \"sphere\" \"float radius\" 0.25\nAttributeEnd\n\
+         AttributeBegin\n Translate 0 1 0\n Rotate 90 1 0 0\n \
+         Shape \"disk\" \"float radius\" 2 \"float height\" 0.5\nAttributeEnd\n\
+         LightSource \"spot\" \"point3 from\" [0 4 0] \"point3 to\" [0 0 0] \"float coneangle\" 25 \"float conedeltaangle\" 10\n",
+    );
+    let (desc, w) = read_pbrt(&p, false).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    // In rust-v's world x is mirrored (see the_image_is_not_mirrored).
+    match &desc.objects[0].shape {
+        ShapeDesc::Sphere { center, radius } => assert_eq!((*center, *radius), ([-5.0, 6.0, 7.0], 1.0)),
+        s => panic!("{s:?}"),
+    }
+    // The eye (1, 2, 3) looking down −z: 3 along the view is (1, 2, 0).
+    match &desc.objects[1].shape {
+        ShapeDesc::Sphere { center, radius } => {
+            assert!((glam::Vec3::from(*center) - glam::Vec3::new(-1.0, 2.0, 0.0)).length() < 1e-5, "{center:?}");
+            assert_eq!(*radius, 0.25);
+        }
+        s => panic!("{s:?}"),
+    }
+    // The disk: its plane z = 0.5 turned 90° about x (z → −y... by hand: R_x(90°) maps
+    // (0, 0, 1) to (0, −1, 0)), then lifted by 1: centre (0, 0.5, 0), normal (0, −1, 0).
+    match &desc.objects[2].shape {
+        ShapeDesc::Disk { center, normal, radius } => {
+            assert!((glam::Vec3::from(*center) - glam::Vec3::new(0.0, 0.5, 0.0)).length() < 1e-6, "{center:?}");
+            assert!((glam::Vec3::from(*normal) - glam::Vec3::new(0.0, -1.0, 0.0)).length() < 1e-6, "{normal:?}");
+            assert_eq!(*radius, 2.0);
+        }
+        s => panic!("{s:?}"),
+    }
+    match &desc.lights[0] {
+        LightDesc::Spot { position, look_at, cone_deg, falloff_deg, .. } => {
+            assert_eq!((*position, *look_at), ([0.0, 4.0, 0.0], [0.0, 0.0, 0.0]));
+            assert_eq!((*cone_deg, *falloff_deg), (25.0, 10.0));
+        }
+        l => panic!("{l:?}"),
+    }
+}
