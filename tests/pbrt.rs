@@ -714,3 +714,34 @@ fn matrices_coordinate_systems_disks_and_spots_by_hand() {
         l => panic!("{l:?}"),
     }
 }
+
+#[test]
+fn ply_files_are_read_once_each_in_order_of_first_use() {
+    let d = temp_dir("pbrt-plys");
+    let ply = |z: f32| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+             element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 {z}\n1 0 {z}\n0 1 {z}\n3 0 1 2\n"
+        )
+    };
+    write(&d, "b.ply", &ply(1.0));
+    write(&d, "a.ply", &ply(2.0));
+    let shape = |f: &str| format!("Shape \"plymesh\" \"string filename\" \"{f}\"\n");
+    let p =
+        write(&d, "s.pbrt", &format!("{HEAD}{}Translate 0 0 1\n{}{}", shape("b.ply"), shape("a.ply"), shape("b.ply")));
+    let scene = load_scene(&p, &small()).unwrap();
+    let names: Vec<String> =
+        scene.inputs.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    assert_eq!(names, ["b.ply", "a.ply"]);
+    let (desc, _) = read_pbrt(&p, false).unwrap();
+    let z: Vec<f32> = desc
+        .objects
+        .iter()
+        .map(|o| match &o.shape {
+            ShapeDesc::Triangles { positions, .. } => positions[0][2],
+            s => panic!("{s:?}"),
+        })
+        .collect();
+    // Each in file order, with its own transform: b at z 1, a at 2 + 1, b at 1 + 1.
+    assert_eq!(z, [1.0, 3.0, 2.0]);
+}

@@ -6,7 +6,9 @@
 //! the image pbrt's left-handed camera space gives (see `begin_world`).
 
 use std::collections::HashMap;
-use std::rc::Rc;
+use std::path::PathBuf;
+
+use rayon::prelude::*;
 
 use glam::{DMat3, DMat4, DVec3};
 
@@ -37,6 +39,28 @@ pub(crate) struct AreaLight {
     scale: f64,
     power: Option<f64>,
     two_sided: bool,
+}
+
+impl AreaLight {
+    /// The emission of a shape of `area` (pbrt's `power` is spread over it).
+    fn emission(&self, area: f64) -> SpectrumDesc {
+        let k = match self.power {
+            Some(p) => p / ((if self.two_sided { 2.0 } else { 1.0 }) * area * std::f64::consts::PI),
+            None => 1.0,
+        };
+        light_spectrum(&self.spectrum, self.rgb, self.scale * k)
+    }
+}
+
+/// A `plymesh` whose file is read after parsing ([`Parser::resolve_plys`]).
+struct PendingPly {
+    object: usize,
+    file: String,
+    floc: Loc,
+    loc: Loc,
+    x: DMat4,
+    reverse: bool,
+    area: Option<AreaLight>,
 }
 
 /// A `Shape` directive as read (kept for `ObjectInstance`).
@@ -81,7 +105,7 @@ pub(crate) struct Built {
     resolution: (u32, u32),
     /// `M`: world space to rust-v's (identity or a mirror).
     pub(crate) mirror: DMat4,
-    ply_cache: HashMap<String, Rc<MeshData>>,
+    pending: Vec<PendingPly>,
     anonymous: usize,
     /// Triangles placed so far (copies of instances included), against [`MAX_TRIANGLES`].
     triangles: usize,
@@ -107,7 +131,7 @@ impl Default for Built {
             render: SettingsPatch::default(),
             resolution: (1280, 720),
             mirror: DMat4::IDENTITY,
-            ply_cache: HashMap::new(),
+            pending: Vec::new(),
             anonymous: 0,
             triangles: 0,
         }
@@ -963,12 +987,12 @@ impl Parser<'_> {
         let at = rec.loc;
         let x = self.built.mirror * instance * rec.ctm;
         let lin = DMat3::from_mat4(x);
-        let flip = rec.reverse ^ (lin.determinant() < 0.0);
         // pbrt's own `reverseOrientation ^ transformSwapsHandedness` (without the mirror `M`),
         // which flips the normal of its quadrics at intersections.
         let quadric_flip = rec.reverse ^ (DMat3::from_mat4(instance * rec.ctm).determinant() < 0.0);
         let what = format!("Shape \"{}\"", rec.ty);
         let mut mesh_file = None;
+        let mut pending = None;
         let (shape, area) = match rec.ty.as_str() {
             "sphere" | "disk" => {
                 let s = self.uniform_scale(lin, at, &rec.ty)?;
@@ -1015,82 +1039,27 @@ impl Parser<'_> {
                     )
                 }
             }
-            "trianglemesh" | "bilinearmesh" | "plymesh" | "loopsubdiv" => {
-                let (positions, mut tris, normals, uvs) = match rec.ty.as_str() {
-                    "plymesh" => {
-                        let Some((file, floc)) = self.string(ps, "filename")? else {
-                            return Err(self.err(at, "Shape \"plymesh\": expected a \"string filename\""));
-                        };
-                        if let Some(p) = self.param(ps, "displacement") {
-                            let loc = p.loc;
-                            self.warn(loc, "plymesh \"displacement\" is not supported (ignored)")?;
-                        }
-                        self.param(ps, "edgelength");
-                        let data = self.ply(&file, floc)?;
-                        mesh_file = Some(file);
-                        let p: Vec<DVec3> = data.positions.iter().map(|v| v.as_dvec3()).collect();
-                        let n = data.normals.as_ref().map(|n| n.iter().map(|v| v.as_dvec3()).collect());
-                        (p, data.triangles.clone(), n, data.uvs.clone())
-                    }
-                    ty => self.inline_mesh(ty, ps, at)?,
+            "plymesh" => {
+                let Some((file, floc)) = self.string(ps, "filename")? else {
+                    return Err(self.err(at, "Shape \"plymesh\": expected a \"string filename\""));
                 };
-                let nv = positions.len();
-                if let Some(k) = tris.iter().position(|t| t.iter().any(|&i| i as usize >= nv)) {
-                    return Err(self.err(
-                        at,
-                        format!("{what}: triangle {k} has a vertex index out of range (there are {nv} vertices)"),
-                    ));
+                if let Some(p) = self.param(ps, "displacement") {
+                    let loc = p.loc;
+                    self.warn(loc, "plymesh \"displacement\" is not supported (ignored)")?;
                 }
-                let world: Vec<DVec3> = positions.iter().map(|p| x.transform_point3(*p)).collect();
-                let area: f64 = tris
-                    .iter()
-                    .map(|t| {
-                        0.5 * (world[t[1] as usize] - world[t[0] as usize])
-                            .cross(world[t[2] as usize] - world[t[0] as usize])
-                            .length()
-                    })
-                    .sum();
-                if flip {
-                    for t in &mut tris {
-                        t.swap(1, 2);
-                    }
-                }
-                let nt = lin.inverse().transpose();
-                let normals: Option<Vec<V3>> = normals.map(|ns: Vec<DVec3>| {
-                    ns.iter()
-                        .map(|n| {
-                            let w = (nt * *n).normalize_or_zero();
-                            f3(if rec.reverse { -w } else { w })
-                        })
-                        .collect()
-                });
-                // With shading normals pbrt turns each triangle's geometric normal towards
-                // them (`FaceForward`): orient the winding the same way.
-                if let Some(ns) = &normals {
-                    for t in &mut tris {
-                        let [a, b, c] = t.map(|i| world[i as usize]);
-                        let s: DVec3 = t.iter().map(|&i| DVec3::from(ns[i as usize].map(f64::from))).sum();
-                        if (b - a).cross(c - a).dot(s) < 0.0 {
-                            t.swap(1, 2);
-                        }
-                    }
-                }
-                self.built.triangles += tris.len();
-                if self.built.triangles > MAX_TRIANGLES {
-                    return Err(self.err(
-                        at,
-                        format!("the scene expands to more than {MAX_TRIANGLES} triangles (instances are copies): expected fewer"),
-                    ));
-                }
-                (
-                    ShapeDesc::Triangles {
-                        positions: world.iter().map(|p| f3(*p)).collect(),
-                        indices: tris,
-                        normals,
-                        uvs,
-                    },
-                    area,
-                )
+                self.param(ps, "edgelength");
+                // Read and placed after parsing, all files at once on the thread pool
+                // (`resolve_plys`); the object keeps its place in the list.
+                pending = Some((file.clone(), floc));
+                mesh_file = Some(file);
+                (ShapeDesc::Triangles { positions: Vec::new(), indices: Vec::new(), normals: None, uvs: None }, 0.0)
+            }
+            "trianglemesh" | "bilinearmesh" | "loopsubdiv" => {
+                let (positions, tris, normals, uvs) = self.inline_mesh(&rec.ty, ps, at)?;
+                let placed = place_mesh(x, rec.reverse, &positions, tris, normals.as_deref(), uvs)
+                    .map_err(|m| self.err(at, format!("{what}: {m}")))?;
+                self.count_triangles(&placed.0, at)?;
+                placed
             }
             other => {
                 self.warn(at, format!("Shape \"{other}\" is not supported (left out)"))?;
@@ -1116,18 +1085,86 @@ impl Parser<'_> {
                 return Ok(());
             }
         };
-        let (emission, two_sided) = match &rec.area {
-            None => (None, false),
-            Some(a) => {
-                let k = match a.power {
-                    Some(p) => p / ((if a.two_sided { 2.0 } else { 1.0 }) * area * std::f64::consts::PI),
-                    None => 1.0,
-                };
-                (Some(light_spectrum(&a.spectrum, a.rgb, a.scale * k)), a.two_sided)
-            }
-        };
+        let emission = rec.area.as_ref().map(|a| a.emission(area));
+        let two_sided = rec.area.as_ref().is_some_and(|a| a.two_sided);
+        if let Some((file, floc)) = pending {
+            let object = self.built.objects.len();
+            self.built.pending.push(PendingPly {
+                object,
+                file,
+                floc,
+                loc: at,
+                x,
+                reverse: rec.reverse,
+                area: rec.area.clone(),
+            });
+        }
         self.built.objects.push(ObjectDesc { shape, material, emission, two_sided, priority: 0, transform: None });
         self.built.mesh_files.push(mesh_file);
+        Ok(())
+    }
+
+    /// Adds a placed mesh's triangles to the count, refusing more than [`MAX_TRIANGLES`].
+    fn count_triangles(&mut self, shape: &ShapeDesc, at: Loc) -> Result<()> {
+        if let ShapeDesc::Triangles { indices, .. } = shape {
+            self.built.triangles += indices.len();
+        }
+        if self.built.triangles > MAX_TRIANGLES {
+            return Err(self.err(
+                at,
+                format!(
+                    "the scene expands to more than {MAX_TRIANGLES} triangles (instances are copies): expected fewer"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Reads every PLY file the `plymesh` shapes name, each once, in parallel, records
+    /// them as inputs in order of first use, and places each shape's triangles (in
+    /// parallel too). Errors are those of the first failing file or shape in file order.
+    pub(crate) fn resolve_plys(&mut self) -> Result<()> {
+        let pending = std::mem::take(&mut self.built.pending);
+        let mut files: Vec<(String, Loc)> = Vec::new();
+        for p in &pending {
+            if !files.iter().any(|(f, _)| *f == p.file) {
+                files.push((p.file.clone(), p.floc));
+            }
+        }
+        let dir = self.ctx.dir.clone();
+        let loaded: Vec<Result<(PathBuf, u64, MeshData)>> = files
+            .par_iter()
+            .map(|(f, _)| {
+                let path = dir.join(f);
+                let bytes = read_input(&path)?;
+                let hash = fnv1a(&bytes);
+                Ok((path.clone(), hash, parse_mesh(bytes, &path)?))
+            })
+            .collect();
+        let mut data = HashMap::new();
+        for ((f, loc), r) in files.iter().zip(loaded) {
+            let (path, hash, mesh) = r.map_err(|e| self.err(*loc, format!("plymesh: {e}")))?;
+            self.ctx.record_input(f, path, hash);
+            data.insert(f.clone(), mesh);
+        }
+        let placed: Vec<std::result::Result<(ShapeDesc, f64), String>> = pending
+            .par_iter()
+            .map(|p| {
+                let d = &data[&p.file];
+                let positions: Vec<DVec3> = d.positions.iter().map(|v| v.as_dvec3()).collect();
+                let normals: Option<Vec<DVec3>> = d.normals.as_ref().map(|n| n.iter().map(|v| v.as_dvec3()).collect());
+                place_mesh(p.x, p.reverse, &positions, d.triangles.clone(), normals.as_deref(), d.uvs.clone())
+            })
+            .collect();
+        for (p, r) in pending.iter().zip(placed) {
+            let (shape, area) = r.map_err(|m| self.err(p.loc, format!("Shape \"plymesh\" \"{}\": {m}", p.file)))?;
+            self.count_triangles(&shape, p.loc)?;
+            let o = &mut self.built.objects[p.object];
+            o.shape = shape;
+            if let Some(a) = &p.area {
+                o.emission = Some(a.emission(area));
+            }
+        }
         Ok(())
     }
 
@@ -1157,19 +1194,6 @@ impl Parser<'_> {
             )?;
         }
         Ok(mean)
-    }
-
-    /// A PLY file's contents (read once per file, recorded in the scene's identity).
-    fn ply(&mut self, file: &str, at: Loc) -> Result<Rc<MeshData>> {
-        if let Some(d) = self.built.ply_cache.get(file) {
-            return Ok(d.clone());
-        }
-        let path = self.ctx.dir.join(file);
-        let bytes = read_input(&path).map_err(|e| self.err(at, format!("plymesh: {e}")))?;
-        self.ctx.record_input(file, path.clone(), fnv1a(&bytes));
-        let data = Rc::new(parse_mesh(bytes, &path).map_err(|e| self.err(at, format!("plymesh: {e}")))?);
-        self.built.ply_cache.insert(file.to_string(), data.clone());
-        Ok(data)
     }
 
     /// `trianglemesh`, `bilinearmesh` and `loopsubdiv` in object space:
@@ -1271,6 +1295,59 @@ impl Parser<'_> {
         }
         Ok((positions, tris, normals, uvs))
     }
+}
+
+/// Triangles in object space placed by `x` (the mirror included) as pbrt-v4 orients
+/// them: the winding flipped by `reverse` and by a transform that swaps handedness, or,
+/// with shading normals, turned towards them (pbrt's `FaceForward`); normals transformed
+/// and flipped by `reverse`. Returns the shape and its area in world space.
+fn place_mesh(
+    x: DMat4,
+    reverse: bool,
+    positions: &[DVec3],
+    mut tris: Vec<[u32; 3]>,
+    normals: Option<&[DVec3]>,
+    uvs: Option<Vec<[f32; 2]>>,
+) -> std::result::Result<(ShapeDesc, f64), String> {
+    let nv = positions.len();
+    if let Some(k) = tris.iter().position(|t| t.iter().any(|&i| i as usize >= nv)) {
+        return Err(format!("triangle {k} has a vertex index out of range (there are {nv} vertices)"));
+    }
+    let lin = DMat3::from_mat4(x);
+    let world: Vec<DVec3> = positions.iter().map(|p| x.transform_point3(*p)).collect();
+    let area: f64 = tris
+        .iter()
+        .map(|t| {
+            0.5 * (world[t[1] as usize] - world[t[0] as usize])
+                .cross(world[t[2] as usize] - world[t[0] as usize])
+                .length()
+        })
+        .sum();
+    if reverse ^ (lin.determinant() < 0.0) {
+        for t in &mut tris {
+            t.swap(1, 2);
+        }
+    }
+    let nt = lin.inverse().transpose();
+    let normals: Option<Vec<V3>> = normals.map(|ns| {
+        ns.iter()
+            .map(|n| {
+                let w = (nt * *n).normalize_or_zero();
+                f3(if reverse { -w } else { w })
+            })
+            .collect()
+    });
+    if let Some(ns) = &normals {
+        for t in &mut tris {
+            let [a, b, c] = t.map(|i| world[i as usize]);
+            let s: DVec3 = t.iter().map(|&i| DVec3::from(ns[i as usize].map(f64::from))).sum();
+            if (b - a).cross(c - a).dot(s) < 0.0 {
+                t.swap(1, 2);
+            }
+        }
+    }
+    let positions = world.iter().map(|p| f3(*p)).collect();
+    Ok((ShapeDesc::Triangles { positions, indices: tris, normals, uvs }, area))
 }
 
 /// `(λ, value)` pairs as a `Table`.

@@ -60,6 +60,7 @@ pub fn read_pbrt(path: &Path, strict: bool) -> Result<(SceneDesc, Vec<String>)> 
 pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> Result<Imported> {
     let mut p = parser::Parser::new(ctx, path, text.to_string(), strict);
     p.run()?;
+    p.resolve_plys()?;
     let warnings = p.warning_lines();
     let b = std::mem::take(&mut p.built);
     let camera = b.camera.ok_or_else(|| crate::error::Error::scene_field(path, "", "the file has no WorldBegin"))?;
