@@ -237,6 +237,9 @@ fn fov_is_the_shorter_side_and_portrait_films_convert_it() {
          WorldBegin\nShape \"sphere\"\n",
     );
     let (desc, _) = read_pbrt(&p, false).unwrap();
+    // No Sampler or Integrator: pbrt-v4's defaults (16 spp, path with maxdepth 5).
+    let r = &desc.render;
+    assert_eq!((r.width, r.height, r.spp, r.max_bounces), (Some(100), Some(200), Some(16), Some(5)));
     // The 40° spans the 100-pixel width; rust-v's vertical fov spans 200 pixels.
     let want = 2.0 * (20f64.to_radians().tan() * 2.0).atan().to_degrees();
     assert!((desc.camera.fov_deg as f64 - want).abs() < 1e-4, "{} vs {want}", desc.camera.fov_deg);

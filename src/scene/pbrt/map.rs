@@ -128,7 +128,16 @@ impl Default for Built {
             environment: None,
             camera: None,
             pending_camera: None,
-            render: SettingsPatch::default(),
+            // pbrt-v4's defaults when a directive is left out: a 1280x720 film, 16 samples
+            // per pixel, the volumetric path tracer with maxdepth 5.
+            render: SettingsPatch {
+                width: Some(1280),
+                height: Some(720),
+                spp: Some(16),
+                max_bounces: Some(5),
+                integrator: Some(IntegratorKind::Path),
+                ..SettingsPatch::default()
+            },
             resolution: (1280, 720),
             mirror: DMat4::IDENTITY,
             pending: Vec::new(),
