@@ -748,3 +748,36 @@ fn ply_files_are_read_once_each_in_order_of_first_use() {
     // Each in file order, with its own transform: b at z 1, a at 2 + 1, b at 1 + 1.
     assert_eq!(z, [1.0, 3.0, 2.0]);
 }
+
+#[test]
+fn an_area_light_seen_directly_has_pbrts_luminance() {
+    // pbrt-v4 divides an area light's scale by its spectrum's luminance ("equivalent to 1
+    // nit"), except an RGB, which keeps its colour: a blackbody at scale 2 is seen with
+    // luminance Y = 2 whatever its temperature, and "rgb L" [0.5 0.5 0.5] with Y = 0.5.
+    let d = temp_dir("pbrt-nits");
+    let seen = |l: &str| {
+        let p = write(
+            &d,
+            "s.pbrt",
+            &format!(
+                "LookAt 0 0 0  0 0 -1  0 1 0\nCamera \"perspective\" \"float fov\" 30\nWorldBegin\n\
+                 AreaLightSource \"diffuse\" {l}\n\
+                 Shape \"trianglemesh\" \"point3 P\" [ -10 -10 -5  10 -10 -5  10 10 -5  -10 10 -5 ] \"integer indices\" [ 0 1 2 0 2 3 ]\n"
+            ),
+        );
+        let o = SettingsPatch { width: Some(8), height: Some(8), spp: Some(2), ..Default::default() };
+        let film = film_of(&load_scene(&p, &o).unwrap());
+        let xyz = film.mean_xyz();
+        xyz.iter().map(|p| p[1]).sum::<f64>() / xyz.len() as f64
+    };
+    for (l, want) in [
+        ("\"blackbody L\" 3000 \"float scale\" 2", 2.0),
+        ("\"blackbody L\" 6500 \"float scale\" 2", 2.0),
+        ("\"spectrum L\" [ 400 1 500 3 600 0.5 700 2 ]", 1.0),
+        ("\"rgb L\" [ 0.5 0.5 0.5 ]", 0.5),
+        ("\"rgb L\" [ 1 1 1 ] \"float power\" 100", 100.0 / (400.0 * std::f64::consts::PI)),
+    ] {
+        let y = seen(l);
+        assert!((y - want).abs() < 2e-3 * want, "{l}: Y {y}, expected {want}");
+    }
+}
