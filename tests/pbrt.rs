@@ -156,8 +156,11 @@ fn include_paths_are_relative_to_the_main_file_and_are_inputs() {
     let d = temp_dir("pbrt-include");
     // pbrt-v4 resolves every relative path against the main file's folder, also inside
     // an included file.
-    write(&d, "geo/a.pbrt", "Include \"geo/b.pbrt\"\nShape \"sphere\"\n");
-    write(&d, "geo/b.pbrt", "Translate 3 0 0 Shape \"sphere\"\n");
+    write(&d, "geo/a.pbrt", "Include \"geo/b.pbrt.gz\"\nShape \"sphere\"\n");
+    // b is gzipped, as pbrt-v4 allows.
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    std::io::Write::write_all(&mut gz, b"Translate 3 0 0 Shape \"sphere\"\n").unwrap();
+    std::fs::write(d.join("geo/b.pbrt.gz"), gz.finish().unwrap()).unwrap();
     let main = write(
         &d,
         "main.pbrt",
@@ -168,10 +171,14 @@ fn include_paths_are_relative_to_the_main_file_and_are_inputs() {
     let scene = load_scene(&main, &small()).unwrap();
     let names: Vec<String> =
         scene.inputs.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-    assert_eq!(names, ["a.pbrt", "b.pbrt"]);
+    assert_eq!(names, ["a.pbrt", "b.pbrt.gz"]);
     // A changed include changes the scene's identity (resume and merge refuse it).
     let before = scene.content_hash;
-    write(&d, "geo/b.pbrt", "Translate 3 0 0 Shape \"sphere\" \"float radius\" 2\n");
+    write(&d, "geo/b.pbrt.gz", "not gzip");
+    let e = load_scene(&main, &small()).err().map(|e| e.to_string()).expect("an error");
+    assert!(e.contains("a.pbrt:1:9:") && e.contains("gzip"), "{e}");
+    write(&d, "geo/a.pbrt", "Include \"geo/c.pbrt\"\nShape \"sphere\"\n");
+    write(&d, "geo/c.pbrt", "Translate 3 0 0 Shape \"sphere\"\n");
     assert_ne!(load_scene(&main, &small()).unwrap().content_hash, before);
 }
 

@@ -761,7 +761,16 @@ impl<'c> Parser<'c> {
             }
         }
         let bytes = read_input(&path).map_err(|e| self.err(at, format!("Include \"{rel}\": {e}")))?;
-        let text = String::from_utf8(bytes.clone()).map_err(|e| {
+        // pbrt-v4 reads gzipped scene files (`geometry.pbrt.gz`) too.
+        let plain = if rel.to_ascii_lowercase().ends_with(".gz") {
+            let mut out = Vec::new();
+            std::io::Read::read_to_end(&mut flate2::read::MultiGzDecoder::new(bytes.as_slice()), &mut out)
+                .map_err(|e| self.err(at, format!("Include \"{rel}\": gzip decompression failed: {e}")))?;
+            out
+        } else {
+            bytes.clone()
+        };
+        let text = String::from_utf8(plain).map_err(|e| {
             self.err(
                 at,
                 format!("Include \"{rel}\": byte {} is not UTF-8; expected UTF-8 text", e.utf8_error().valid_up_to()),
