@@ -788,3 +788,20 @@ fn an_area_light_seen_directly_has_pbrts_luminance() {
         assert!((y - want).abs() < 2e-3 * want, "{l}: Y {y}, expected {want}");
     }
 }
+
+#[test]
+fn killeroo_simple_from_pbrt_v4_scenes_loads_and_renders() {
+    // scripts/fetch-pbrt-scenes.sh puts it in ../shared/pbrt-v4-scenes.
+    let Some(p) = crate::common::shared("pbrt-v4-scenes/killeroos/killeroo-simple.pbrt") else {
+        eprintln!("skipped: run scripts/fetch-pbrt-scenes.sh to fetch killeroo-simple.pbrt");
+        return;
+    };
+    let (scene, w) = load_scene_with_warnings(&p, &small(), false).unwrap();
+    // Expected: the film's file name (a note) and coateddiffuse rendered as Plastic.
+    assert!(
+        w.iter().all(|l| l.contains("Film \"filename\"") || l.contains("coateddiffuse is rendered as Plastic")),
+        "{w:?}"
+    );
+    let film = film_of(&scene);
+    assert!(film.mean_xyz().iter().map(|p| p[1]).sum::<f64>() > 0.01, "the scene is lit");
+}
