@@ -316,7 +316,7 @@ impl Parser<'_> {
             ("spectrum", Value::Nums(v)) => table(v),
             ("spectrum", Value::Strs(s)) => {
                 let name = s[0].clone();
-                self.named_or_file(&name, loc, role)?
+                self.named_or_file(&name, loc)?
             }
             ("texture", Value::Strs(s)) if role == Role::Reflectance => match self.built.textures.get(&s[0]) {
                 Some(Tex::Spectrum(d)) => d.clone(),
@@ -339,7 +339,7 @@ impl Parser<'_> {
     }
 
     /// A named spectrum of pbrt-v4, or a spectrum file (`λ value` pairs).
-    fn named_or_file(&mut self, name: &str, loc: Loc, role: Role) -> Result<SpectrumDesc> {
+    fn named_or_file(&mut self, name: &str, loc: Loc) -> Result<SpectrumDesc> {
         let approx = |p: &mut Self, what: &str, s: SpectrumDesc| -> Result<SpectrumDesc> {
             p.warn(loc, format!("named spectrum \"{name}\" is approximated by {what}"))?;
             Ok(s)
@@ -356,7 +356,6 @@ impl Parser<'_> {
                 || n.starts_with("nikon_")
                 || n.starts_with("sony_") =>
             {
-                let _ = role;
                 return Err(self.err(loc, format!("named spectrum \"{name}\" cannot be used here (it is an index of refraction or a camera's curve)")));
             }
             _ => {}
