@@ -7,6 +7,8 @@
 //!   brown-grey ground.
 //! - `scenes/textures/chart.png`: a 96x64 8-bit sRGB chart of 6x4 coloured
 //!   patches (the ColorChecker's order, approximate sRGB values) on a black grid.
+//! - `scenes/media/smoke.vol`: a 24³ density grid (Mitsuba's `.vol`, see
+//!   `rust_v::medium::grid`): a soft cloud of three overlapping blobs, 0 to about 1.
 //!
 //! Run: `cargo run --release --example make_textures` (from the repository root).
 
@@ -78,4 +80,22 @@ fn main() {
         image::Rgb(PATCHES[((y / 16) * 6 + x / 16) as usize])
     });
     img.save("scenes/textures/chart.png").unwrap();
+
+    let n = 24usize;
+    let blobs = [([0.45f32, 0.4, 0.5], 0.22f32), ([0.62, 0.55, 0.45], 0.18), ([0.38, 0.62, 0.55], 0.15)];
+    let data: Vec<f32> = (0..n * n * n)
+        .map(|k| {
+            let p = [(k % n) as f32, ((k / n) % n) as f32, (k / (n * n)) as f32].map(|v| (v + 0.5) / n as f32);
+            blobs
+                .iter()
+                .map(|(c, r)| {
+                    let d2: f32 = (0..3).map(|i| (p[i] - c[i]).powi(2)).sum();
+                    (-d2 / (r * r)).exp()
+                })
+                .sum::<f32>()
+                .min(1.0)
+        })
+        .collect();
+    std::fs::create_dir_all("scenes/media").unwrap();
+    std::fs::write("scenes/media/smoke.vol", rust_v::medium::grid::write_vol([n, n, n], &data)).unwrap();
 }

@@ -9,7 +9,7 @@
 //! Data flow: the material's `reflectance:` ([`crate::scene::desc::SpectrumDesc`])
 //! is built once at load into a [`Texture`]; a material whose reflectance is
 //! not constant keeps it beside its [`crate::bxdf::Bxdf`], and
-//! [`crate::scene::Scene::bsdf_at`] evaluates it once per hit (the lobe with
+//! [`crate::scene::Scene::bsdf_in`] evaluates it once per hit (the lobe with
 //! the texel's reflectance in place of the constant one). A scene without
 //! textures never computes a (u, v) and pays one branch per hit.
 //!
@@ -68,8 +68,9 @@ pub struct ImageTexture {
 }
 
 impl Texture {
-    /// The reflectance at surface coordinates `uv`.
-    #[inline]
+    /// The reflectance at surface coordinates `uv` (out of line: the hot path of
+    /// an untextured scene stays small).
+    #[inline(never)]
     pub fn eval(&self, uv: Vec2) -> Spectrum {
         match self {
             Texture::Checkerboard { even, odd, scale } => {

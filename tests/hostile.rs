@@ -476,6 +476,38 @@ fn mesh_transform_errors_name_the_field() {
     }
 }
 
+/// The thin lens's fields (issue 32): a negative or NaN aperture, a focus
+/// distance of 0, negative or infinite: one error line naming the field. A
+/// huge aperture is no error and renders without a NaN (the film would count it).
+#[test]
+fn thin_lens_errors_name_the_field() {
+    let d = temp_dir("hostile-lens");
+    let cases = [
+        ("aperture_radius: -0.1", "camera.aperture_radius"),
+        ("aperture_radius: NaN", "camera.aperture_radius"),
+        ("aperture_radius: inf", "camera.aperture_radius"),
+        ("aperture_radius: 0.1, focus_distance: 0", "camera.focus_distance"),
+        ("aperture_radius: 0.1, focus_distance: -2", "camera.focus_distance"),
+        ("focus_distance: NaN", "camera.focus_distance"),
+        ("aperture_radius: 0.1, focus_distance: inf", "camera.focus_distance"),
+    ];
+    for (fields, want) in cases {
+        let p = d.join("t.ron");
+        std::fs::write(&p, SCENE.replace("fov_deg: 30)", &format!("fov_deg: 30, {fields})"))).unwrap();
+        let e = one_error(&run(&["render", s(&p), "-o", s(&d.join("t.png"))]), 1);
+        assert!(e.contains(want) && e.contains("t.ron"), "{fields}: {e}");
+    }
+    let p = d.join("huge.ron");
+    std::fs::write(&p, SCENE.replace("fov_deg: 30)", "fov_deg: 30, aperture_radius: 1e15, focus_distance: 1e-3)"))
+        .unwrap();
+    for integrator in ["path", "bdpt", "lighttrace"] {
+        let o = run(&["render", s(&p), "--integrator", integrator, "-o", s(&d.join("huge.png"))]);
+        let err = stderr(&o);
+        assert!(o.status.success(), "{integrator}: {err}");
+        assert!(!err.contains("NaN or infinite"), "{integrator}: {err}");
+    }
+}
+
 // ---------------------------------------------------------------------------
 // 8. Consistent limits.
 
@@ -983,6 +1015,14 @@ fn bad_environment_maps_are_one_error_naming_the_field() {
         (r#"Image(path: "one.exr", rotate_deg: (0, inf, 0))"#, "environment.rotate_deg", "finite"),
         ("Uniform(Constant(0))", "environment", "black"),
         ("Uniform(Constant(-1))", "environment.Uniform", ""),
+        ("Sky(sun_elevation_deg: 95)", "environment.sun_elevation_deg", "[0, 90]"),
+        ("Sky(sun_elevation_deg: -1)", "environment.sun_elevation_deg", "[0, 90]"),
+        ("Sky(sun_elevation_deg: NaN)", "environment.sun_elevation_deg", "[0, 90]"),
+        ("Sky(sun_elevation_deg: 30, turbidity: 11)", "environment.turbidity", "[1, 10]"),
+        ("Sky(sun_elevation_deg: 30, turbidity: 0.5)", "environment.turbidity", "[1, 10]"),
+        ("Sky(sun_elevation_deg: 30, ground_albedo: 1.5)", "environment.ground_albedo", "[0, 1]"),
+        ("Sky(sun_elevation_deg: 30, sun_azimuth_deg: inf)", "environment.sun_azimuth_deg", "finite"),
+        ("Sky(sun_elevation_deg: 30, scale: 0)", "environment.scale", "positive"),
     ] {
         let p = scene_in(&dir, &scene(env));
         let o = run(&["render", s(&p), "-o", s(&out)]);
@@ -992,4 +1032,131 @@ fn bad_environment_maps_are_one_error_naming_the_field() {
     let p = scene_in(&dir, &scene(r#"Image(path: "one.exr")"#));
     let o = run(&["render", s(&p), "-o", s(&out)]);
     assert!(o.status.success(), "a 1x1 map: {}", stderr(&o));
+}
+
+/// Bad textures are one error line naming the field; uv far outside [0, 1]
+/// on a mesh, a 65536-wide environment map and a 1x1 texture render.
+#[test]
+fn bad_textures_are_one_error_and_odd_ones_render() {
+    let dir = temp_dir("hostile_textures");
+    image::Rgb32FImage::from_raw(2, 1, vec![0.5, f32::NAN, 0.5, 0.5, 0.5, 0.5])
+        .unwrap()
+        .save(dir.join("nan.exr"))
+        .unwrap();
+    image::RgbImage::from_raw(1, 1, vec![200, 100, 50]).unwrap().save(dir.join("one.png")).unwrap();
+    let png = std::fs::read(dir.join("one.png")).unwrap();
+    std::fs::write(dir.join("truncated.png"), &png[..png.len() / 2]).unwrap();
+    image::Rgb32FImage::from_raw(65536, 1, vec![0.25; 65536 * 3]).unwrap().save(dir.join("wide.exr")).unwrap();
+    let scene = |reflectance: &str, env: &str| {
+        format!(
+            r#"(camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40), render: (width: 8, height: 8, spp: 2),
+            materials: {{ "m": Lambertian(reflectance: {reflectance}) }},
+            objects: [
+                (shape: Triangles(positions: [(-1, -1, 0), (1, -1, 0), (0, 1, 0)], indices: [(0, 1, 2)],
+                    uvs: [(-1e6, 5.3), (2e7, -2), (0.5, 1e30)]), material: "m"),
+                (shape: Sphere(center: (0, 0, -2), radius: 0.5), emission: Constant(1)),
+            ],
+            {env})"#
+        )
+    };
+    let out = dir.join("out.png");
+    for (refl, field, what) in [
+        (r#"Image(path: "missing.png")"#, "materials.\"m\".reflectance.path", "missing.png"),
+        (r#"Image(path: "truncated.png")"#, "materials.\"m\".reflectance.path", "decode"),
+        (r#"Image(path: "nan.exr")"#, "materials.\"m\".reflectance.path", "texel (0, 0)"),
+        (r#"Image(path: "one.png", scale: 0)"#, "materials.\"m\".reflectance.scale", "positive"),
+        (r#"Image(path: "one.png", uv_scale: (1, inf))"#, "materials.\"m\".reflectance.uv_scale", "finite"),
+        ("Checkerboard(even: Constant(2), odd: Constant(0.5), scale: 4)", "reflectance.even", "[0, 1]"),
+        ("Checkerboard(even: Constant(0.2), odd: Constant(0.5), scale: -4)", "reflectance.scale", "positive"),
+    ] {
+        let p = scene_in(&dir, &scene(refl, ""));
+        let o = run(&["render", s(&p), "-o", s(&out)]);
+        let e = one_error(&o, 1);
+        assert!(e.contains(field) && e.contains(what), "{refl}: {e}");
+    }
+    // A texture where only a spectrum may stand.
+    let p = scene_in(
+        &dir,
+        &scene(
+            "Constant(0.5)",
+            "lights: [ Point(position: (0, 0, 1), intensity: Checkerboard(even: D65, odd: D65, scale: 1)) ],",
+        ),
+    );
+    let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+    assert!(e.contains("lights[0].intensity") && e.contains("texture"), "{e}");
+    // Odd but valid: a 1x1 texture on a mesh with uvs far outside [0, 1], and a 65536 x 1 map.
+    for (refl, env) in [
+        (r#"Image(path: "one.png", wrap: Clamp)"#, ""),
+        (r#"Image(path: "one.png")"#, r#"environment: Image(path: "wide.exr"),"#),
+    ] {
+        let p = scene_in(&dir, &scene(refl, env));
+        let o = run(&["render", s(&p), "-o", s(&out)]);
+        assert!(o.status.success(), "{refl} {env}: {}", stderr(&o));
+    }
+}
+
+/// Bad media: one error line naming the field.
+#[test]
+fn bad_media_are_one_error_naming_the_field() {
+    let dir = temp_dir("hostile_media");
+    let scene = |medium: &str, object: &str| {
+        format!(
+            r#"(camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40), render: (width: 8, height: 8, spp: 1),
+            media: {{ "m": {medium} }},
+            materials: {{ "b": Interface, "white": Lambertian(reflectance: Constant(0.5)),
+                          "tinted": Dielectric(ior: Constant(1.5), absorption: Constant(1)) }},
+            objects: [ {object} ],
+            environment: Uniform(Constant(1)))"#
+        )
+    };
+    let sphere = |material: &str, interior: &str| {
+        format!(r#"(shape: Sphere(center: (0, 0, 0), radius: 1), material: "{material}", interior: "{interior}")"#)
+    };
+    let good = "Homogeneous(sigma_a: Constant(0.1), sigma_s: Constant(1))";
+    let out = dir.join("out.png");
+    for (medium, object, field, what) in [
+        (good, sphere("b", "fog"), "objects[0].interior", "unknown medium \"fog\""),
+        (good, sphere("white", "m"), "objects[0].interior", "Dielectric or an Interface"),
+        (good, sphere("tinted", "m"), "objects[0].interior", "absorption"),
+        ("Homogeneous(sigma_a: Constant(-1), sigma_s: Constant(1))", sphere("b", "m"), "media.\"m\".sigma_a", ""),
+        ("Homogeneous(sigma_a: Constant(0), sigma_s: Constant(NaN))", sphere("b", "m"), "media.\"m\".sigma_s", ""),
+        ("Homogeneous(sigma_a: Constant(0), sigma_s: Rayleigh(-2))", sphere("b", "m"), "media.\"m\".sigma_s", ""),
+        (
+            "Homogeneous(sigma_a: Constant(0), sigma_s: Constant(1), phase: HenyeyGreenstein(g: 1))",
+            sphere("b", "m"),
+            "media.\"m\".phase.g",
+            "0.999",
+        ),
+        ("Homogeneous(sigma_a: Constant(0))", sphere("b", "m"), "sigma_s", ""),
+    ] {
+        let p = scene_in(&dir, &scene(medium, &object));
+        let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+        assert!(e.contains(field) && e.contains(what), "{medium} {object}: {e}");
+    }
+    // Grid files: missing, truncated, wrong sizes, NaN and negative densities.
+    let vol = rust_v::medium::grid::write_vol([2, 2, 2], &[0.5; 8]);
+    std::fs::write(dir.join("truncated.vol"), &vol[..vol.len() - 4]).unwrap();
+    std::fs::write(dir.join("short.vol"), &vol[..30]).unwrap();
+    std::fs::write(dir.join("nan.vol"), rust_v::medium::grid::write_vol([2, 1, 1], &[0.5, f32::NAN])).unwrap();
+    std::fs::write(dir.join("neg.vol"), rust_v::medium::grid::write_vol([2, 1, 1], &[-0.5, 1.0])).unwrap();
+    let mut oversized = vol.clone();
+    oversized[8..12].copy_from_slice(&1_000_000i32.to_le_bytes());
+    std::fs::write(dir.join("oversized.vol"), &oversized).unwrap();
+    for (file, what) in [
+        ("missing.vol", "missing.vol"),
+        ("truncated.vol", "bytes of data"),
+        ("short.vol", "48-byte"),
+        ("nan.vol", "voxel (1, 0, 0)"),
+        ("neg.vol", "voxel (0, 0, 0)"),
+        ("oversized.vol", "voxels"),
+    ] {
+        let grid = format!(r#"Grid(path: "{file}", sigma_a: Constant(0), sigma_s: Constant(1))"#);
+        let p = scene_in(&dir, &scene(&grid, &sphere("b", "m")));
+        let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+        assert!(e.contains("media.\"m\".path") && e.contains(what), "{file}: {e}");
+    }
+    // Twice the same medium name.
+    let p = scene_in(&dir, &scene(&format!("{good}, \"m\": {good}"), &sphere("b", "m")));
+    let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+    assert!(e.contains("duplicate medium \"m\""), "{e}");
 }

@@ -7,6 +7,7 @@ mod common;
 
 mod auto;
 mod bdpt;
+mod camera;
 mod checkpoint;
 mod cli;
 mod docs;
@@ -15,6 +16,7 @@ mod furnace;
 mod fuzz;
 mod hostile;
 mod lights;
+mod media;
 mod memory;
 mod metrics;
 mod output;

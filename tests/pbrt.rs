@@ -240,7 +240,8 @@ fn fov_is_the_shorter_side_and_portrait_films_convert_it() {
     let p = write(
         &d,
         "s.pbrt",
-        "Camera \"perspective\" \"float fov\" 40\nFilm \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200\n\
+        "Camera \"perspective\" \"float fov\" 40 \"float lensradius\" 0.05 \"float focaldistance\" 3\n\
+         Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200\n\
          WorldBegin\nShape \"sphere\"\n",
     );
     let (desc, _) = read_pbrt(&p, false).unwrap();
@@ -249,7 +250,10 @@ fn fov_is_the_shorter_side_and_portrait_films_convert_it() {
     assert_eq!((r.width, r.height, r.spp, r.max_bounces), (Some(100), Some(200), Some(16), Some(5)));
     // The 40° spans the 100-pixel width; rust-v's vertical fov spans 200 pixels.
     let want = 2.0 * (20f64.to_radians().tan() * 2.0).atan().to_degrees();
-    assert!((desc.camera.fov_deg as f64 - want).abs() < 1e-4, "{} vs {want}", desc.camera.fov_deg);
+    // pbrt's thin lens: the same radius and focal plane distance.
+    assert_eq!((desc.camera.aperture_radius, desc.camera.focus_distance), (0.05, Some(3.0)));
+    let fov = desc.camera.fov_deg.expect("a fov") as f64;
+    assert!((fov - want).abs() < 1e-4, "{fov} vs {want}");
 }
 
 #[test]

@@ -99,9 +99,10 @@ fn readme_scene_example_loads() {
     assert_eq!((scene.objects[7].priority, scene.objects[8].priority), (1, 2), "priorities of the nested glass");
     assert_eq!(
         scene.lights.len(),
-        9,
-        "disk, sphere, quad, cuboid and mesh emitters; point, spot, distant and beam lights"
+        10,
+        "disk, sphere, quad, cuboid and mesh emitters; point, spot, distant and beam lights; the sky"
     );
+    assert!(scene.has_environment());
     assert!(scene.has_dispersion());
 }
 

@@ -97,6 +97,9 @@ pub enum Bxdf {
     Plastic(Plastic),
     /// A free-standing thin film (soap film): interference reflection, straight transmission.
     ThinSheet(ThinSheet),
+    /// An index-matched boundary: light passes straight through; it only
+    /// bounds a volume (and the medium inside it).
+    Interface,
 }
 
 impl Bxdf {
@@ -138,7 +141,7 @@ impl Bxdf {
             Bxdf::Conductor(m) => m.eval(wo, wi, lambdas),
             Bxdf::Plastic(m) => m.eval(wo, wi, lambdas),
             Bxdf::Dielectric(m) => m.eval_packet(wo, wi, m.relative_eta_for(lambdas, outside), lambdas),
-            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => Sampled::splat(0.0),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) | Bxdf::Interface => Sampled::splat(0.0),
         }
     }
 
@@ -168,6 +171,17 @@ impl Bxdf {
             Bxdf::Conductor(m) => m.sample(wo, u, lambdas),
             Bxdf::Plastic(m) => m.sample(wo, u, uc, lambdas),
             Bxdf::ThinSheet(m) => m.sample(wo, uc, lambdas),
+            Bxdf::Interface => {
+                // Straight on, weight 1: f |cos| / pdf = 1.
+                let cos = wo.z.abs();
+                (cos > 0.0).then(|| BsdfSample {
+                    wi: -wo,
+                    f: Sampled::splat(1.0 / cos),
+                    pdf: 1.0,
+                    is_delta: true,
+                    eta: 1.0,
+                })
+            }
         }
     }
 
@@ -177,7 +191,7 @@ impl Bxdf {
     #[inline]
     pub fn reads_draws(&self) -> (bool, bool) {
         match self {
-            Bxdf::Black | Bxdf::Mirror(_) => (false, false),
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::Interface => (false, false),
             Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) => (true, false),
             Bxdf::Conductor(m) => (!m.is_smooth(), false),
             Bxdf::Dielectric(m) => (!m.is_smooth(), true),
@@ -201,7 +215,7 @@ impl Bxdf {
             Bxdf::Conductor(m) => m.pdf(wo, wi),
             Bxdf::Plastic(m) => m.pdf(wo, wi, lambdas),
             Bxdf::Dielectric(m) => m.pdf_packet(wo, wi, m.relative_eta_for(lambdas, outside), lambdas),
-            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => 0.0,
+            Bxdf::Black | Bxdf::Mirror(_) | Bxdf::ThinSheet(_) | Bxdf::Interface => 0.0,
         }
     }
 
@@ -218,7 +232,7 @@ impl Bxdf {
     #[inline]
     pub fn is_delta(&self) -> bool {
         match self {
-            Bxdf::Mirror(_) | Bxdf::ThinSheet(_) => true,
+            Bxdf::Mirror(_) | Bxdf::ThinSheet(_) | Bxdf::Interface => true,
             Bxdf::Dielectric(d) => d.is_smooth(),
             Bxdf::Conductor(c) => c.is_smooth(),
             Bxdf::Black | Bxdf::Lambertian(_) | Bxdf::OrenNayar(_) | Bxdf::Plastic(_) => false,
@@ -259,6 +273,19 @@ impl Bxdf {
             Bxdf::Dielectric(d) => d.absorption(),
             _ => None,
         }
+    }
+
+    /// True when the model bounds a volume (a dielectric or an index-matched
+    /// interface): its inside is a medium for the volume stack.
+    #[inline]
+    pub fn bounds_volume(&self) -> bool {
+        matches!(self, Bxdf::Dielectric(_) | Bxdf::Interface)
+    }
+
+    /// True for an index-matched boundary ([`Bxdf::Interface`]).
+    #[inline]
+    pub fn is_interface(&self) -> bool {
+        matches!(self, Bxdf::Interface)
     }
 
     /// True when the model absorbs everything (a path ends here).

@@ -368,7 +368,7 @@ fn warn_no_effect(scene: &Scene) {
     // water spheres act as neither). Shapes compared exactly; meshes are not compared.
     let mut seen = std::collections::HashMap::new();
     for (i, o) in scene.objects.iter().enumerate() {
-        let dielectric = scene.materials.get(o.material as usize).and_then(|m| m.as_dielectric()).is_some();
+        let dielectric = scene.materials.get(o.material as usize).is_some_and(|m| m.bounds_volume());
         if o.priority != 0 && !dielectric {
             warn(format_args!(
                 "objects[{i}].priority: {} has no effect: the object is not a dielectric, and only dielectric volumes nest by priority",

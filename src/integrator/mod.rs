@@ -44,7 +44,11 @@ pub use bdpt::Bdpt;
 pub use path::PathTracer;
 pub use whitted::Whitted;
 
+use std::sync::LazyLock;
+
 use glam::{Vec2, Vec3};
+
+use crate::camera::lens_system::D_LINE_NM;
 
 use crate::bxdf::{Bxdf, Outside};
 use crate::color::Sampled;
@@ -57,7 +61,10 @@ use crate::scene::{Scene, SurfaceHit};
 
 pub(crate) use crate::scene::MAX_PASSES;
 use crate::settings::{IntegratorKind, WavelengthsKind};
-use crate::spectral::{Contribution, Lambdas, WavelengthSampling, sample_packet, sample_packet_continuous};
+use crate::spectral::{
+    BinDistribution, Contribution, Lambdas, Readout, WavelengthSampling, bin_importance, continuous_wavelength,
+    sample_packet, sample_packet_continuous,
+};
 
 /// Computes the colour of one camera sample. Implementations are chosen once
 /// per render and the render loop is generic over them.
@@ -84,6 +91,13 @@ pub(crate) enum Transport {
 }
 
 impl Transport {
+    /// True when the transport follows dispersion (`auto`, `spectral`); `path`
+    /// and `whitted` refract every wavelength alike, a dispersive lens too.
+    #[inline]
+    fn disperses(&self) -> bool {
+        matches!(self, Transport::Path(p) if p.disperse)
+    }
+
     /// Radiance along `ray` for the packet `lambdas`, as XYZ.
     #[inline]
     pub fn li<const N: usize, O: Contribution>(
@@ -106,7 +120,15 @@ pub(crate) struct FullSpectrum(pub Transport);
 impl Estimator for FullSpectrum {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
-        let ray = scene.camera.ray(film);
+        if let Some(system) = scene.camera.lens_system() {
+            let u = sampler.get_2d(Dim::LENS);
+            if system.is_dispersive() && self.0.disperses() {
+                let one = one_wavelength::<O>(sampler.get_1d(Dim::wavelength(0)));
+                return through_lens_system(&self.0, scene, film, u, &one, sampler);
+            }
+            return through_lens_system(&self.0, scene, film, u, &Lambdas::full(), sampler);
+        }
+        let ray = camera_ray(scene, film, sampler);
         self.0.li(scene, ray, &Lambdas::full(), sampler)
     }
 }
@@ -119,7 +141,18 @@ pub(crate) struct Packets<const C: usize>(pub Transport, pub WavelengthSampling,
 impl<const C: usize> Estimator for Packets<C> {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
-        let ray = scene.camera.ray(film);
+        if let Some(system) = scene.camera.lens_system() {
+            let u_lens = sampler.get_2d(Dim::LENS);
+            let u: [f32; C] = std::array::from_fn(|i| sampler.get_1d(Dim::wavelength(i)));
+            let dispersive = system.is_dispersive();
+            let lambdas = if O::CONTINUOUS && (self.2 || dispersive || scene.has_dispersion()) {
+                sample_packet_continuous::<C>(self.1, u)
+            } else {
+                sample_packet::<C>(self.1, u)
+            };
+            return through_lens_system_split(&self.0, scene, film, u_lens, &lambdas, dispersive, sampler);
+        }
+        let ray = camera_ray(scene, film, sampler);
         let u: [f32; C] = std::array::from_fn(|i| sampler.get_1d(Dim::wavelength(i)));
         let lambdas = if O::CONTINUOUS && (self.2 || scene.has_dispersion()) {
             sample_packet_continuous::<C>(self.1, u)
@@ -136,9 +169,82 @@ pub(crate) struct RgbWavelengths(pub Transport);
 impl Estimator for RgbWavelengths {
     #[inline]
     fn sample<O: Contribution>(&self, scene: &Scene, film: Vec2, sampler: &mut Sampler, _: &mut Vec<Splat<O>>) -> O {
-        let ray = scene.camera.ray(film);
+        if let Some(system) = scene.camera.lens_system() {
+            let u = sampler.get_2d(Dim::LENS);
+            let dispersive = system.is_dispersive();
+            return through_lens_system_split(&self.0, scene, film, u, &Lambdas::rgb(), dispersive, sampler);
+        }
+        let ray = camera_ray(scene, film, sampler);
         self.0.li(scene, ray, &Lambdas::rgb(), sampler)
     }
+}
+
+/// The estimate through a lens system for film position `film` and
+/// exit-pupil sample `u`: one ray for the packet `lambdas`, traced at the d
+/// line, or, for a one-wavelength packet through a dispersive lens, at its
+/// wavelength; its weight scales the packet's. A blocked ray sees nothing.
+fn through_lens_system<const N: usize, O: Contribution>(
+    transport: &Transport,
+    scene: &Scene,
+    film: Vec2,
+    u: Vec2,
+    lambdas: &Lambdas<N>,
+    sampler: &mut Sampler,
+) -> O {
+    let cam = &scene.camera;
+    let dispersive = cam.lens_system().is_some_and(|s| s.is_dispersive());
+    let nm = if N == 1 && dispersive && transport.disperses() { lambdas.lambda_nm(0) } else { D_LINE_NM };
+    match cam.lens_system_ray(film, u, nm) {
+        Some((ray, w)) => transport.li(scene, ray, &Lambdas { weight: lambdas.weight * w, ..*lambdas }, sampler),
+        None => O::default(),
+    }
+}
+
+/// [`through_lens_system`] for a packet: whole when the lens does not
+/// disperse, else each wavelength on its own ray (carrying the packet's
+/// weight; they share the exit-pupil sample and the per-bounce draws, as the
+/// walks of a packet split at dispersive glass do).
+fn through_lens_system_split<const N: usize, O: Contribution>(
+    transport: &Transport,
+    scene: &Scene,
+    film: Vec2,
+    u: Vec2,
+    lambdas: &Lambdas<N>,
+    dispersive: bool,
+    sampler: &mut Sampler,
+) -> O {
+    if !dispersive {
+        return through_lens_system(transport, scene, film, u, lambdas, sampler);
+    }
+    let mut out = O::default();
+    for i in 0..N {
+        out += through_lens_system(transport, scene, film, u, &lambdas.single(i), sampler);
+    }
+    out
+}
+
+/// One wavelength drawn from `u` by visual importance (as BDPT's collapse
+/// draws it), with weight `1/p`: continuous for colour output, a bin centre
+/// for spectral output.
+fn one_wavelength<O: Contribution>(u: f32) -> Lambdas<1> {
+    static DIST: LazyLock<BinDistribution> = LazyLock::new(|| {
+        let importance = bin_importance();
+        BinDistribution::new(|b| importance[b]).expect("visual importance is positive")
+    });
+    if O::CONTINUOUS {
+        continuous_wavelength(&DIST, u).0
+    } else {
+        let (b, p) = DIST.sample(u);
+        Lambdas { pos: [b as f32], weight: 1.0 / p, readout: Readout::Spectral }
+    }
+}
+
+/// The camera ray through film position `film`: with a thin lens, through
+/// the lens point of a [`Dim::LENS`] draw; a pinhole draws nothing.
+#[inline]
+pub(crate) fn camera_ray(scene: &Scene, film: Vec2, sampler: &mut Sampler) -> Ray {
+    let cam = &scene.camera;
+    if cam.has_lens() { cam.ray_through(film, sampler.get_2d(Dim::LENS)) } else { cam.ray(film) }
 }
 
 /// Calls `f` with the estimator the settings ask for: the one place where the
@@ -151,7 +257,7 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
         Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
     };
     match settings.integrator {
-        IntegratorKind::Auto if needs_bdpt(scene) => f.call(&bdpt(false)),
+        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => f.call(&bdpt(false)),
         IntegratorKind::Auto => f.call(&FullSpectrum(path(true))),
         IntegratorKind::Bdpt => f.call(&bdpt(false)),
         IntegratorKind::LightTrace => f.call(&bdpt(true)),
@@ -185,10 +291,27 @@ pub fn needs_bdpt(scene: &Scene) -> bool {
 /// One line saying which light-transport model the settings pick for this
 /// scene and why (printed once by `rust-v render`).
 pub fn describe(scene: &Scene) -> String {
+    let line = describe_transport(scene);
+    match scene.camera.lens_system() {
+        Some(lens) if lens.is_dispersive() => match scene.settings.integrator {
+            IntegratorKind::Auto => format!(
+                "{line}; the camera's lens disperses: one continuous wavelength per camera sample, drawn by visual importance, on its own ray through the lens"
+            ),
+            IntegratorKind::Spectral => format!(
+                "{line}; the camera's lens disperses: each wavelength of a packet on its own ray through the lens"
+            ),
+            _ => format!("{line}; the camera's lens refracts every wavelength like the d line (587.56 nm)"),
+        },
+        _ => line,
+    }
+}
+
+/// [`describe`] without the camera's lens.
+fn describe_transport(scene: &Scene) -> String {
     let s = &scene.settings;
     let dispersive = scene.has_dispersion();
     match s.integrator {
-        IntegratorKind::Auto if needs_bdpt(scene) => format!(
+        IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => format!(
             "auto: a point, spot, distant or beam light meets a specular surface (caustics path tracing cannot find): bidirectional path tracing{}",
             if dispersive { "; the full spectrum until a subpath refracts at dispersive glass, then one wavelength" } else { ", full spectrum" }
         ),
@@ -313,7 +436,7 @@ pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut VolumeStack, si: &Surf
         return Interface::Scatter { outside: Outside::VACUUM, crossing: None };
     };
     let entering = dir.dot(si.hit.n) < 0.0;
-    match media.crossing(m, entering) {
+    match scene.crossing(media, m, entering) {
         Crossing::Pass => {
             media.cross(m, entering);
             Interface::Pass
@@ -369,7 +492,48 @@ pub(crate) fn sample_direct<const N: usize>(
     } else {
         power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, outside))
     };
-    f * lambdas.sample(&scene.light(choice.light).radiance(ls.wi)) * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+    let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
+    f * le * (ls.scale * wi_local.z.abs() * weight / pdf_light)
+}
+
+/// One next-event estimate at a scattering event at `p` in a medium (the
+/// path arrived travelling along `−wo`): a light chosen by power, a point on
+/// it, a shadow ray through [`Scene::transmittance`] from the volumes `volumes`
+/// (the medium's transmittance on the way), the phase function's value, and
+/// the MIS weight against phase sampling (power heuristic). Its numbers are
+/// the next-event draws of depth `depth`, as a surface vertex's.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub(crate) fn sample_direct_medium<const N: usize>(
+    scene: &Scene,
+    phase: &crate::medium::HenyeyGreenstein,
+    p: Vec3,
+    wo: Vec3,
+    volumes: &VolumeStack,
+    lambdas: &Lambdas<N>,
+    sampler: &mut Sampler,
+    depth: u32,
+) -> Sampled<N> {
+    let zero = Sampled::splat(0.0);
+    let u_light = sampler.get_1d_if(scene.light_count() > 1, Dim::light_choice(depth));
+    let u = sampler.get_2d(Dim::light_sample(depth));
+    let Some(choice) = scene.sample_li(p, u_light, u) else {
+        return zero;
+    };
+    let ls = choice.sample;
+    let f = phase.eval(wo, ls.wi);
+    if !(f > 0.0) {
+        return zero;
+    }
+    let Some(clear) = scene.transmittance(p, Vec3::ZERO, Some(volumes), ls.point, ls.n) else {
+        return zero;
+    };
+    let mut t = Sampled::splat(f);
+    clear.attenuate(&mut t, lambdas);
+    let pdf_light = choice.pmf * ls.pdf;
+    let weight = if ls.is_delta { 1.0 } else { power_heuristic(pdf_light, f) };
+    let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
+    t * le * (ls.scale * weight / pdf_light)
 }
 
 #[cfg(test)]

@@ -144,10 +144,36 @@ impl PathTracer {
         let mut passes = 0;
         loop {
             let hit = &si.hit;
-            // 0. Beer-Lambert absorption along the segment, in the medium it ran
-            //    in (once: a split walk starts at a hit already counted).
+            // 0. The medium the segment ran in (once: a split walk starts at a
+            //    hit already counted): Beer-Lambert where it only absorbs; where
+            //    it scatters, a distance drawn by spectral MIS, and a scattering
+            //    event before the surface is a vertex of the path.
             if add_emission && let Some(medium) = scene.medium_in(w.media.current()) {
-                w.beta *= medium.transmittance(hit.t, lambdas);
+                if medium.scatters() || medium.is_grid() {
+                    let u = sampler.get_1d(Dim::medium_distance(w.bounces));
+                    let d = medium.sample_distance_along(ray.origin, ray.dir, hit.t, lambdas, u);
+                    w.beta *= d.weight;
+                    if d.scattered {
+                        match self.scatter_in_medium(
+                            scene,
+                            medium,
+                            ray.at(d.t),
+                            ray.dir,
+                            &mut w,
+                            &mut l,
+                            lambdas,
+                            sampler,
+                        ) {
+                            Some((next_ray, next)) => {
+                                (ray, si) = (next_ray, next);
+                                continue;
+                            }
+                            None => break,
+                        }
+                    }
+                } else {
+                    w.beta *= medium.transmittance(hit.t, lambdas);
+                }
             }
             // 1. Emission, MIS-weighted against the light sample taken at the previous vertex.
             if add_emission && let Some(e) = scene.le(&si, ray.dir) {
@@ -182,7 +208,8 @@ impl PathTracer {
             if w.bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = &*scene.bsdf_at(&si);
+            let mut textured = None;
+            let bxdf = scene.bsdf_in(&si, &mut textured);
             if bxdf.is_black() {
                 break;
             }
@@ -371,6 +398,53 @@ impl PathTracer {
             *split += self.walk::<1, O>(scene, ray, si, one, &l1, sampler, Start::SplitRefraction);
         });
         None
+    }
+}
+
+impl PathTracer {
+    /// A scattering event at `p` in `medium` for a path that travelled along
+    /// `dir`: next-event estimation with the phase function (MIS against
+    /// phase sampling, the power heuristic), then a direction from the phase
+    /// function (its weight is 1), Russian roulette, and the next hit. Adds
+    /// what it finds to `l`; `None` when the path ends (depth, roulette, or
+    /// escape: the environment is added then).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn scatter_in_medium<const N: usize>(
+        &self,
+        scene: &Scene,
+        medium: &crate::medium::Medium,
+        p: glam::Vec3,
+        dir: glam::Vec3,
+        w: &mut Walk<N>,
+        l: &mut Sampled<N>,
+        lambdas: &Lambdas<N>,
+        sampler: &mut Sampler,
+    ) -> Option<(Ray, SurfaceHit)> {
+        if w.bounces >= self.max_bounces || w.beta.is_black() {
+            return None;
+        }
+        let phase = medium.phase();
+        let wo = -dir;
+        *l += w.beta * super::sample_direct_medium(scene, phase, p, wo, &w.media, lambdas, sampler, w.bounces);
+        let (wi, pdf) = phase.sample(wo, sampler.get_2d(Dim::bsdf(w.bounces)));
+        w.bounces += 1;
+        w.prev = Prev { p, pdf_bsdf: pdf, delta: false };
+        if w.bounces >= RR_DEPTH {
+            let q = (w.beta.max_value() * w.eta_scale).min(1.0);
+            if sampler.get_1d_if(q < 1.0, Dim::roulette(w.bounces - 1)) >= q {
+                return None;
+            }
+            w.beta /= q;
+        }
+        let ray = Ray::new(p, wi);
+        match scene.intersect(&ray, f32::INFINITY) {
+            Some(next) => Some((ray, next)),
+            None => {
+                *l += escape(scene, &ray, w, lambdas);
+                None
+            }
+        }
     }
 }
 

@@ -75,7 +75,8 @@ impl Whitted {
             if bounces >= self.max_bounces {
                 break;
             }
-            let bxdf = &*scene.bsdf_at(&si);
+            let mut textured = None;
+            let bxdf = scene.bsdf_in(&si, &mut textured);
             if bxdf.is_black() {
                 break;
             }

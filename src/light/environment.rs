@@ -311,7 +311,7 @@ impl EnvironmentLight {
     }
 
     /// The radiance arriving from world direction `wi` (pointing away from the scene).
-    #[inline]
+    #[inline(never)]
     pub fn radiance(&self, wi: Vec3) -> Spectrum {
         match &self.source {
             Source::Uniform(s) => *s,
@@ -327,7 +327,7 @@ impl EnvironmentLight {
 
     /// A direction towards the environment from `p`, by its density; the
     /// returned point lies beyond the scene's bounds along it.
-    #[inline]
+    #[inline(never)]
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         let (wi, pdf) = self.sample_direction(u)?;
         let point = p + wi * (2.0 * self.scene_radius);
@@ -335,7 +335,7 @@ impl EnvironmentLight {
     }
 
     /// The density per solid angle of [`Self::sample_li`] choosing world direction `wi`.
-    #[inline]
+    #[inline(never)]
     pub fn pdf_li(&self, wi: Vec3) -> f32 {
         match &self.source {
             Source::Uniform(_) => 1.0 / (4.0 * PI),

@@ -110,15 +110,17 @@ impl Light {
         }
     }
 
-    /// What arrives from the light along the sampled direction `wi` (from
-    /// the shading point towards the light), as [`Light::spectrum`] says
-    /// for each kind: the environment's radiance from `wi`, every other
-    /// light's one spectrum.
-    #[inline]
-    pub fn radiance(&self, wi: Vec3) -> std::borrow::Cow<'_, Spectrum> {
+    /// `f` of what arrives from the light along the sampled direction `wi`
+    /// (from the shading point towards the light), as [`Light::spectrum`]
+    /// says for each kind: the environment's radiance from `wi`, every other
+    /// light's one spectrum. A closure, not a `Cow`: returning a `Cow` of a
+    /// 36-bin spectrum from next-event estimation cost the Cornell box 4.5%
+    /// more instructions (callgrind), the other lights paying for the copy.
+    #[inline(always)]
+    pub fn with_radiance<R>(&self, wi: Vec3, f: impl FnOnce(&Spectrum) -> R) -> R {
         match self {
-            Light::Environment(l) => std::borrow::Cow::Owned(l.radiance(wi)),
-            _ => std::borrow::Cow::Borrowed(self.spectrum()),
+            Light::Environment(l) => f(&l.radiance(wi)),
+            _ => f(self.spectrum()),
         }
     }
 

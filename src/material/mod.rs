@@ -8,7 +8,7 @@
 //! [`crate::scene::Scene::materials`]; objects refer to it by index), and,
 //! where the reflectance is a texture (`Image`, `Checkerboard`: Lambertian,
 //! OrenNayar, Mirror and Plastic), the [`Texture`] beside it, which
-//! [`crate::scene::Scene::bsdf_at`] evaluates at each hit
+//! [`crate::scene::Scene::bsdf_in`] evaluates at each hit
 //! ([`Bxdf::with_reflectance`]).
 //!
 //! Errors name the scene file and the field path
@@ -132,6 +132,7 @@ fn bxdf_of<'a>(
             Bxdf::ThinSheet(ThinSheet { film: thin_film(check, field, *thickness_nm, ior)? })
         }
         MaterialDesc::Black => Bxdf::Black,
+        MaterialDesc::Interface => Bxdf::Interface,
     })
 }
 

@@ -38,7 +38,12 @@
 //! | [`Dim::collapse`]`(depth)` | 1D | `auto`: reflect or collapse at dispersive glass |
 //! | [`Dim::collapse_bins`]`(depth)` | 1D | `auto`: the rotation of the drawn bins |
 //! | [`Dim::EMIT_CHOICE`], [`Dim::EMIT_POSITION`], [`Dim::EMIT_DIRECTION`] | 1D, 2D, 2D | BDPT's light subpath: the light, a point and a direction leaving it |
+//! | [`Dim::LENS`] | 2D | the point on a thin lens of the camera ray (drawn only when the camera has a lens) |
+//! | [`Dim::lens_from_light`]`(i)` | 2D | BDPT's `t = 1` with a thin lens: the lens point light vertex `y_i` connects to (the [`Dim::light_sample`] slot of the light subpath's block: it has no next-event estimation) |
 //! | `d.`[`on_light_path`](Dim::on_light_path)`()` | as `d` | a per-bounce draw on BDPT's light subpath (its own block) |
+//!
+//! The fixed draws take ids 0 to 12 ([`Dim::FILM`] 0, the wavelengths 1 to 8, the
+//! light subpath's start 9 to 11, [`Dim::LENS`] 12); 13 to 15 are free.
 //!
 //! A bounce's block has 8 slots and uses 7; **slot 7 is kept for a
 //! participating medium's distance draw** (1D) at that depth. A vertex
@@ -90,6 +95,9 @@ impl Dim {
     pub const EMIT_POSITION: Dim = Dim(10);
     /// BDPT: the direction leaving the light (2D).
     pub const EMIT_DIRECTION: Dim = Dim(11);
+    /// The camera ray's point on a thin lens (2D; not drawn for a pinhole,
+    /// so that pinhole images stay what they were with either sampler).
+    pub const LENS: Dim = Dim(12);
 
     /// Wavelength draw `i` of a packet (1D; `i < 8` is on the table).
     #[inline]
@@ -132,6 +140,12 @@ impl Dim {
         Dim::bounce(depth, 4)
     }
 
+    /// A scattering medium at depth `depth`: where the path scatters (1D; slot 7).
+    #[inline]
+    pub fn medium_distance(depth: u32) -> Dim {
+        Dim::bounce(depth, 7)
+    }
+
     /// `auto` at dispersive glass at depth `depth`: reflect, or collapse (1D).
     #[inline]
     pub fn collapse(depth: u32) -> Dim {
@@ -142,6 +156,14 @@ impl Dim {
     #[inline]
     pub fn collapse_bins(depth: u32) -> Dim {
         Dim::bounce(depth, 6)
+    }
+
+    /// BDPT's connection of light vertex `y_i` to a thin lens (`t = 1`): the
+    /// lens point (2D). The light subpath's [`Dim::light_sample`] slot of
+    /// depth `i`, unused there (a light subpath makes no next-event estimate).
+    #[inline]
+    pub fn lens_from_light(i: u32) -> Dim {
+        Dim::light_sample(i).on_light_path()
     }
 
     /// This per-bounce draw on BDPT's light subpath (a block of its own).

@@ -48,6 +48,10 @@ pub struct SceneDesc {
     /// Lights that are not objects (point lights).
     #[serde(default)]
     pub lights: Vec<LightDesc>,
+    /// Named participating media, referred to by objects' `interior:`
+    /// (`crate::medium`): `media: { "milk": Homogeneous(sigma_a: ..., sigma_s: ..., phase: HenyeyGreenstein(g: 0.7)) }`.
+    #[serde(default)]
+    pub media: NamedMap<MediumDesc>,
     /// Radiance from infinitely far away, seen by every ray that escapes
     /// (`crate::light::EnvironmentLight`); none by default (escaping rays see black).
     #[serde(default)]
@@ -108,7 +112,17 @@ fn is_zero(v: &u32) -> bool {
     *v == 0
 }
 
-impl Serialize for Materials {
+fn is_zero_f32(v: &f32) -> bool {
+    *v == 0.0
+}
+
+/// A map from names to descriptions in file order (`materials`, `media`); a
+/// name given twice is an error (`duplicate material "white"`), where a plain
+/// map would keep the last.
+#[derive(Debug)]
+pub struct NamedMap<T>(pub Vec<(String, T)>);
+
+impl<T: Serialize> Serialize for NamedMap<T> {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeMap;
         let mut map = s.serialize_map(Some(self.0.len()))?;
@@ -119,36 +133,103 @@ impl Serialize for Materials {
     }
 }
 
-/// The `materials` map in file order; a name given twice is an error
-/// (`duplicate material "white"`), where a plain map would keep the last.
-#[derive(Debug, Default)]
-pub struct Materials(pub Vec<(String, MaterialDesc)>);
+/// The `materials` map.
+pub type Materials = NamedMap<MaterialDesc>;
 
-impl<'de> Deserialize<'de> for Materials {
+impl<T> Default for NamedMap<T> {
+    fn default() -> Self {
+        NamedMap(Vec::new())
+    }
+}
+
+/// What a [`NamedMap`]'s entries are called in errors.
+pub trait Noun {
+    /// `material`, `medium`.
+    const NOUN: &'static str;
+}
+
+impl Noun for MaterialDesc {
+    const NOUN: &'static str = "material";
+}
+
+impl Noun for MediumDesc {
+    const NOUN: &'static str = "medium";
+}
+
+impl<'de, T: Deserialize<'de> + Noun> Deserialize<'de> for NamedMap<T> {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct Visit;
-        impl<'de> serde::de::Visitor<'de> for Visit {
-            type Value = Materials;
+        struct Visit<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de> + Noun> serde::de::Visitor<'de> for Visit<T> {
+            type Value = NamedMap<T>;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a map from material names to materials")
+                write!(f, "a map from {} names to descriptions", T::NOUN)
             }
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Materials, A::Error> {
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<NamedMap<T>, A::Error> {
                 let mut seen = BTreeSet::new();
                 let mut out = Vec::new();
                 while let Some(name) = map.next_key::<String>()? {
                     if !seen.insert(name.clone()) {
-                        return Err(serde::de::Error::custom(format!("duplicate material \"{name}\"")));
+                        return Err(serde::de::Error::custom(format!("duplicate {} \"{name}\"", T::NOUN)));
                     }
                     out.push((name, map.next_value()?));
                 }
-                Ok(Materials(out))
+                Ok(NamedMap(out))
             }
         }
-        d.deserialize_map(Visit)
+        d.deserialize_map(Visit(std::marker::PhantomData))
     }
 }
 
-/// A pinhole camera.
+/// A participating medium (`crate::medium`): coefficients per scene unit.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub enum MediumDesc {
+    /// The same everywhere:
+    /// `Homogeneous(sigma_a: Constant(0.01), sigma_s: Rayleigh(0.5), phase: Isotropic)`.
+    Homogeneous {
+        /// Absorption coefficient per scene unit.
+        sigma_a: SpectrumDesc,
+        /// Scattering coefficient per scene unit.
+        sigma_s: SpectrumDesc,
+        /// The phase function (default `Isotropic`).
+        #[serde(default)]
+        phase: PhaseDesc,
+    },
+    /// A density on a voxel grid (Mitsuba's `.vol`, 32-bit floats, one channel)
+    /// filling the object's bounding box, times the coefficients:
+    /// `Grid(path: "smoke.vol", sigma_a: Constant(0.5), sigma_s: Constant(4), density_scale: 1, phase: Isotropic)`.
+    Grid {
+        /// The `.vol` file, relative to the scene file.
+        path: String,
+        /// Absorption coefficient per scene unit at density 1.
+        sigma_a: SpectrumDesc,
+        /// Scattering coefficient per scene unit at density 1.
+        sigma_s: SpectrumDesc,
+        /// A factor on the density (default 1).
+        #[serde(default = "one")]
+        density_scale: f32,
+        /// The phase function (default `Isotropic`).
+        #[serde(default)]
+        phase: PhaseDesc,
+    },
+}
+
+/// A medium's phase function.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub enum PhaseDesc {
+    /// The same in every direction (the default).
+    #[default]
+    Isotropic,
+    /// Henyey-Greenstein of mean cosine `g` in [−0.999, 0.999] (> 0 forward):
+    /// `HenyeyGreenstein(g: 0.7)`.
+    HenyeyGreenstein {
+        /// The mean cosine of the scattering angle.
+        g: f32,
+    },
+}
+
+/// A pinhole camera, a thin lens with depth of field, or a lens system.
 #[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
@@ -159,8 +240,40 @@ pub struct CameraDesc {
     /// The up direction (default `(0, 1, 0)`).
     #[serde(default = "default_up")]
     pub up: V3,
-    /// Vertical field of view in degrees.
-    pub fov_deg: f32,
+    /// Vertical field of view in degrees (required, except with a `lens`,
+    /// whose focal length and film set it).
+    #[serde(default)]
+    pub fov_deg: Option<f32>,
+    /// The thin lens's radius in scene units (default 0: a pinhole, no depth of field).
+    #[serde(default, skip_serializing_if = "is_zero_f32")]
+    pub aperture_radius: f32,
+    /// The distance of the plane in focus along the view direction (default:
+    /// from `eye` to `look_at`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub focus_distance: Option<f32>,
+    /// A lens system in front of a film, instead of the pinhole or thin lens.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lens: Option<LensDesc>,
+}
+
+/// A lens system camera: a lens file (pbrt's format, with an optional glass
+/// column) and its settings.
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LensDesc {
+    /// The lens file, relative to the scene file.
+    pub file: String,
+    /// The aperture stop's opening, a diameter in mm (at most the stop's own).
+    pub aperture_diameter_mm: f32,
+    /// The distance from the film to the plane in focus, in scene units (metres).
+    pub focus_distance: f32,
+    /// The film's diagonal in mm (default 35).
+    #[serde(default = "default_film_diagonal")]
+    pub film_diagonal_mm: f32,
+}
+
+fn default_film_diagonal() -> f32 {
+    35.0
 }
 
 fn default_up() -> V3 {
@@ -190,6 +303,8 @@ pub enum SpectrumDesc {
     /// A two-column CSV file (`nm,value` per line, relative to the scene file; a header line,
     /// blank lines and `#` comments are allowed), read like `Table`: `File("data/led.csv")`.
     File(String),
+    /// Scattering that falls as λ⁻⁴ (Rayleigh): `s · (550 nm / λ)⁴`: `Rayleigh(0.5)`.
+    Rayleigh(f32),
     /// Linear sRGB, uplifted to a smooth spectrum (Jakob and Hanika 2019): as a reflectance
     /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
     /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
@@ -332,6 +447,9 @@ pub enum MaterialDesc {
         #[serde(default)]
         roughness: f32,
     },
+    /// An index-matched boundary (`Interface`): light passes straight through; it
+    /// bounds the volume its object's `interior:` medium fills.
+    Interface,
     /// A free-standing thin film (soap film): `ThinSheet(thickness_nm: 400, ior: Constant(1.33))`.
     ThinSheet {
         /// Thickness in nm.
@@ -475,6 +593,10 @@ pub struct ObjectDesc {
     /// (default: as given). See [`TransformDesc`] for what each shape accepts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<TransformDesc>,
+    /// The name of a medium in `media` filling the object's inside (its
+    /// material must be a `Dielectric` or an `Interface`): `interior: "milk"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interior: Option<String>,
 }
 
 /// An object's placement, applied to its shape: scale, then rotate about x, then y,

@@ -8,19 +8,21 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use glam::Vec3;
 use rayon::prelude::*;
 
-use super::check::{Check, Input};
-use super::desc::{SceneDesc, ShapeDesc};
+use super::check::{Check, Input, MAX_MAGNITUDE};
+use super::desc::{CameraDesc, LensDesc, SceneDesc, ShapeDesc};
 use super::{Object, Scene};
 use crate::bxdf::Bxdf;
-use crate::camera::Camera;
+use crate::camera::lens_system::{D_LINE_NM, LensSystem};
+use crate::camera::{Camera, LensCamera};
 use crate::error::{Error, Result};
 use crate::geometry::Transform;
 use crate::io::{Fnv1a, fnv1a, read_input};
 use crate::light::{EnvironmentLight, Light};
 use crate::material;
-use crate::settings::{Settings, SettingsPatch};
+use crate::settings::{IntegratorKind, Settings, SettingsPatch};
 use crate::shape::{Mesh, MeshAhead, Placement, Shape};
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
@@ -176,6 +178,11 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         materials.push(bxdf);
         textures.push(texture);
     }
+    // Media by name.
+    let mut media = BTreeMap::new();
+    for (name, m) in &desc.media.0 {
+        media.insert(name.as_str(), crate::medium::from_desc(ctx, &format!("media.\"{name}\""), m)?);
+    }
 
     // Every mesh file is read, parsed and built (with its BVH) at once on the
     // thread pool; the loop below takes them in object order, so the scene,
@@ -235,7 +242,42 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
                 Some(lights.len() as u32 - 1)
             }
         };
-        objects.push(Object { shape, material, light, priority: o.priority });
+        let interior = match &o.interior {
+            None => None,
+            Some(name) => {
+                let field = format!("{field}.interior");
+                let m = media.get(name.as_str()).ok_or_else(|| {
+                    let known: Vec<&str> = media.keys().copied().collect();
+                    ctx.err(&field, format!("unknown medium \"{name}\"; defined: {}", known.join(", ")))
+                })?;
+                let bxdf = &materials[material as usize];
+                if !bxdf.bounds_volume() {
+                    return Err(ctx.err(
+                        &field,
+                        "an interior needs a material that bounds a volume: a Dielectric or an Interface",
+                    ));
+                }
+                if bxdf.absorption().is_some() {
+                    return Err(ctx.err(
+                        &field,
+                        "the material has an `absorption:` (itself an interior medium); give one or the other",
+                    ));
+                }
+                let m = if m.is_grid() {
+                    let b = shape.bounds().ok_or_else(|| {
+                        ctx.err(
+                            &field,
+                            "a Grid medium fills its object's bounds: the object must be bounded (not a Plane)",
+                        )
+                    })?;
+                    m.placed(b.min, b.max)
+                } else {
+                    m.clone()
+                };
+                Some(Box::new(m))
+            }
+        };
+        objects.push(Object { shape, material, light, priority: o.priority, interior });
     }
     for (i, l) in desc.lights.iter().enumerate() {
         lights.push(Light::from_desc(ctx, &format!("lights[{i}]"), l)?);
@@ -245,6 +287,14 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     }
     if objects.is_empty() {
         return Err(ctx.err("objects", "expected at least one object"));
+    }
+    if let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.is_grid()))
+        && settings.integrator == IntegratorKind::Whitted
+    {
+        return Err(ctx.err(
+            format!("objects[{i}].interior"),
+            "a Grid medium: whitted does not track media; use auto, path or spectral",
+        ));
     }
 
     let c = &desc.camera;
@@ -256,11 +306,74 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     if forward.cross(up).length() < 1e-4 {
         return Err(ctx.err("camera.up", "must not be parallel to the view direction"));
     }
-    if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
-        return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {}", c.fov_deg)));
-    }
-    let camera = Camera::new(eye, look_at, up, c.fov_deg, settings.width, settings.height);
+    let camera = match &c.lens {
+        None => {
+            let fov = match c.fov_deg {
+                Some(f) if f > 0.0 && f < 180.0 => f,
+                Some(f) => return Err(ctx.err("camera.fov_deg", format!("expected degrees in (0, 180), found {f}"))),
+                None => {
+                    return Err(
+                        ctx.err("camera.fov_deg", "expected the vertical field of view in degrees, in (0, 180)")
+                    );
+                }
+            };
+            if !(c.aperture_radius >= 0.0 && c.aperture_radius <= MAX_MAGNITUDE) {
+                return Err(ctx.err(
+                    "camera.aperture_radius",
+                    format!(
+                        "expected a radius from 0 (a pinhole) up to {MAX_MAGNITUDE:e}, found {}",
+                        c.aperture_radius
+                    ),
+                ));
+            }
+            let focus = match c.focus_distance {
+                Some(f) => ctx.positive("camera.focus_distance", f)?,
+                None => (look_at - eye).length(),
+            };
+            Camera::new(eye, look_at, up, fov, settings.width, settings.height).with_thin_lens(c.aperture_radius, focus)
+        }
+        Some(lens) => lens_camera(ctx, c, lens, (eye, look_at, up), &settings)?,
+    };
     Ok(Scene::new(objects, materials, textures, lights, camera, settings, 0))
+}
+
+/// The camera looking through the lens system `lens` of camera block `c`.
+fn lens_camera(
+    ctx: &Check<'_>,
+    c: &CameraDesc,
+    lens: &LensDesc,
+    (eye, look_at, up): (Vec3, Vec3, Vec3),
+    settings: &Settings,
+) -> Result<Camera> {
+    for (given, field) in [
+        (c.fov_deg.is_some(), "camera.fov_deg"),
+        (c.aperture_radius != 0.0, "camera.aperture_radius"),
+        (c.focus_distance.is_some(), "camera.focus_distance"),
+    ] {
+        if given {
+            return Err(ctx.err(field, "not with a `lens`: the lens's own fields set the view, aperture and focus"));
+        }
+    }
+    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace) {
+        return Err(ctx.err(
+            "camera.lens",
+            "bdpt and lighttrace need the camera's importance, which a lens system does not define (as in pbrt-v4); use auto, path, spectral or whitted",
+        ));
+    }
+    let aperture = ctx.positive("camera.lens.aperture_diameter_mm", lens.aperture_diameter_mm)?;
+    let focus = ctx.positive("camera.lens.focus_distance", lens.focus_distance)?;
+    let diagonal = ctx.positive("camera.lens.film_diagonal_mm", lens.film_diagonal_mm)?;
+    let (path, bytes) = ctx.read_input("camera.lens.file", &lens.file)?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| ctx.err("camera.lens.file", format!("{}: expected UTF-8 text", path.display())))?;
+    let system = LensSystem::parse(&text, &path)?;
+    let camera =
+        LensCamera::new(&system, aperture as f64, focus as f64 * 1e3, diagonal as f64, settings.width, settings.height)
+            .map_err(|m| ctx.err("camera.lens", format!("{}: {m}", lens.file)))?;
+    // The pinhole methods get the lens's field of view (nothing renders with them).
+    let efl = camera.lens().effective_focal_length(D_LINE_NM).unwrap_or(50.0);
+    let fov = (2.0 * (camera.film_size().1 / 2.0).atan2(efl)).to_degrees().clamp(1e-3, 179.0) as f32;
+    Ok(Camera::new(eye, look_at, up, fov, settings.width, settings.height).with_lens_system(camera))
 }
 
 /// Combines defaults, the file's `render` block and the command line, and checks the result.

@@ -49,6 +49,9 @@ pub struct Object {
     /// Where dielectric volumes overlap, the higher priority wins (nested
     /// dielectrics, [`crate::medium::nested`]).
     pub priority: u32,
+    /// The medium filling the object's volume (`interior:`, or a dielectric's
+    /// `absorption:` as a medium that only absorbs); `None`: clear.
+    pub interior: Option<Box<Medium>>,
 }
 
 /// The closest hit of a ray in the scene.
@@ -84,9 +87,11 @@ pub struct Scene {
     nested: bool,
     /// Some object is a dielectric ([`Scene::has_volumes`]).
     volumes: bool,
-    /// The medium inside each material's volume (index for index with
-    /// `materials`; `None`: clear, or not a dielectric).
-    media: Vec<Option<Medium>>,
+    /// Some object's interior scatters or is a grid (a path samples distances there).
+    scattering: bool,
+    /// Some object is an index-matched boundary (`Interface`): shadow rays
+    /// pass it ([`Scene::transmittance`]).
+    interfaces: bool,
     /// Render settings: the file's `render` block with command-line overrides applied.
     pub settings: Settings,
     /// Indices of bounded objects, in the BVH's order when there is one.
@@ -147,8 +152,18 @@ impl Scene {
         }
         let camera_volumes = volumes_at(camera.eye(), &objects, &materials);
         let nested = nested_volumes(&camera_volumes, &objects, &materials);
-        let volumes = objects.iter().any(|o| materials[o.material as usize].as_dielectric().is_some());
-        let media = materials.iter().map(|m| m.absorption().map(|s| Medium::absorbing(*s))).collect();
+        let volumes = objects.iter().any(|o| materials[o.material as usize].bounds_volume());
+        // A dielectric's absorption is its volume's medium (one that only absorbs).
+        let mut objects = objects;
+        for o in &mut objects {
+            if o.interior.is_none()
+                && let Some(a) = materials[o.material as usize].absorption()
+            {
+                o.interior = Some(Box::new(Medium::absorbing(*a)));
+            }
+        }
+        let scattering = objects.iter().any(|o| o.interior.as_ref().is_some_and(|m| m.scatters() || m.is_grid()));
+        let interfaces = objects.iter().any(|o| materials[o.material as usize].is_interface());
         let batch = Batch::new(bounded.iter().map(|&i| (i, &objects[i as usize].shape)));
         let bvh = (batch.is_none() && bounded.len() >= BVH_MIN_OBJECTS).then(|| {
             let bvh = Bvh::build(&bounds);
@@ -187,7 +202,8 @@ impl Scene {
             camera_volumes,
             nested,
             volumes,
-            media,
+            scattering,
+            interfaces,
             settings,
             bounded,
             unbounded,
@@ -278,7 +294,9 @@ impl Scene {
     #[inline]
     pub fn volume(&self, object: u32) -> Option<Volume> {
         let o = &self.objects[object as usize];
-        self.materials[o.material as usize].as_dielectric()?;
+        if !self.materials[o.material as usize].bounds_volume() {
+            return None;
+        }
         Some(Volume { object, priority: o.priority, material: o.material })
     }
 
@@ -342,7 +360,7 @@ fn volumes_at(p: glam::Vec3, objects: &[Object], materials: &[Bxdf]) -> VolumeSt
     let mut found = [(0.0f32, Volume::default()); VOLUME_STACK_DEPTH];
     let mut count = 0;
     for (i, o) in objects.iter().enumerate() {
-        if materials[o.material as usize].as_dielectric().is_none() {
+        if !materials[o.material as usize].bounds_volume() {
             continue;
         }
         let (mut leave, mut enter, mut nearest) = (0, 0, f32::INFINITY);
@@ -380,11 +398,8 @@ fn nested_volumes(camera_volumes: &VolumeStack, objects: &[Object], materials: &
     if !camera_volumes.is_empty() {
         return true;
     }
-    let glass: Vec<Option<Aabb>> = objects
-        .iter()
-        .filter(|o| materials[o.material as usize].as_dielectric().is_some())
-        .map(|o| o.shape.bounds())
-        .collect();
+    let glass: Vec<Option<Aabb>> =
+        objects.iter().filter(|o| materials[o.material as usize].bounds_volume()).map(|o| o.shape.bounds()).collect();
     glass.iter().enumerate().any(|(i, a)| {
         glass[i + 1..].iter().any(|b| match (a, b) {
             (Some(a), Some(b)) => a.min.cmple(b.max).all() && b.min.cmple(a.max).all(),

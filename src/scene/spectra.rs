@@ -111,6 +111,12 @@ impl Check<'_> {
                     "a texture (Image, Checkerboard) can stand only for a material's reflectance; expected a spectrum",
                 ));
             }
+            SpectrumDesc::Rayleigh(s) => {
+                if !(s.is_finite() && *s >= 0.0) {
+                    return Err(self.err(field, format!("expected a non-negative scale, found {s}")));
+                }
+                Spectrum::from_fn(|b| s * (550.0 / color::bin_lambda_nm(b)).powi(4))
+            }
             SpectrumDesc::D65 => color::d65(),
             SpectrumDesc::EqualEnergy => color::equal_energy(),
             SpectrumDesc::Blackbody(t) => color::blackbody(*t)

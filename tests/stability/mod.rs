@@ -11,9 +11,11 @@ use rust_v::film::Film;
 use rust_v::settings::{IntegratorKind, SettingsPatch, WavelengthsKind};
 
 mod bias;
+mod environment;
 mod glass;
 mod lighttrace;
 mod materials;
+mod media;
 mod nested;
 mod surfaces;
 

@@ -11,37 +11,39 @@ use crate::spectral::Lambdas;
 
 use super::mis::{Overrides, mis_weight};
 use super::vertex::{
-    Contrib, Kind, Vertex, Wavelength, bsdf_at, connectible, is_dispersive, outside, pdf_at, pdf_light,
-    shading_correction, to_area,
+    Contrib, Kind, Vertex, Wavelength, bsdf_at, connectible, consistent_at, cos_at, cos_normal, is_dispersive, outside,
+    pdf_at, pdf_light, scatter_at, shading_correction, to_area,
 };
 use super::{Bdpt, Sub};
 
 impl Bdpt {
-    /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye. Returns
-    /// the film position and the MIS-weighted contribution.
+    /// Strategy `(s, t = 1)`: light vertex `y_{s-1}` seen by the eye, or by a
+    /// point of a thin lens drawn uniformly ([`Dim::lens_from_light`], pbrt-v4's
+    /// `PerspectiveCamera::SampleWi`). Returns the film position and the
+    /// MIS-weighted contribution.
     pub(super) fn connect_camera(
         &self,
         scene: &Scene,
         light: Sub<'_>,
         s: usize,
         camera: Sub<'_>,
+        sampler: &mut Sampler,
         wl: &mut Wavelength,
     ) -> Option<(Vec2, Contrib)> {
+        let cam = &scene.camera;
+        let eye =
+            if cam.has_lens() { cam.lens_point(sampler.get_2d(Dim::lens_from_light(s as u32 - 1))) } else { cam.eye() };
         let qs = &light.v[s - 1];
         if !connectible(scene, qs) {
             return None;
         }
-        let cam = &scene.camera;
-        let eye = cam.eye();
         let to_eye = eye - qs.p();
         let d2 = to_eye.length_squared();
         if d2.is_nan() || d2 <= 0.0 {
             return None;
         }
         let w = to_eye / d2.sqrt();
-        let film = cam.project(-w)?;
-        let cos_cam = (-w).dot(cam.forward());
-        let importance = 1.0 / (d2 * cam.plane_area() * cos_cam * cos_cam * cos_cam);
+        let (film, importance) = cam.importance(eye, -w, d2)?;
         let single = qs.collapsed || is_dispersive(scene, qs);
         // Emission (s = 1) or the adjoint BSDF towards the eye, with the cosine at y.
         let c = match qs.kind {
@@ -59,7 +61,8 @@ impl Bdpt {
                 if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
             }
             Kind::Surface(o) => {
-                let bxdf = bsdf_at(scene, o, qs);
+                let mut slot = None;
+                let bxdf = bsdf_at(scene, o, qs, &mut slot);
                 let wi = qs.sh.frame.to_local(w);
                 if !qs.sh.consistent(w, wi) {
                     return None;
@@ -74,6 +77,17 @@ impl Bdpt {
                     Contrib::Full(qs.beta * bxdf.eval_within(wi, qs.sh.wo, &Lambdas::full(), out) * k)
                 }
             }
+            Kind::Medium(_) => {
+                // The phase function towards the eye (symmetric: no adjoint correction, no cosine).
+                let wi = qs.sh.frame.to_local(w);
+                if single {
+                    let one = wl.single();
+                    let f = scatter_at(scene, qs, wi, qs.sh.wo, &one.lambdas)[0];
+                    Contrib::Single(wl.at(&qs.beta, qs.collapsed) * f * importance)
+                } else {
+                    Contrib::Full(qs.beta * scatter_at(scene, qs, wi, qs.sh.wo, &Lambdas::full()) * importance)
+                }
+            }
             Kind::Camera => return None,
         };
         if is_black(&c) {
@@ -83,10 +97,13 @@ impl Bdpt {
         let weight = if self.light_only {
             1.0
         } else {
-            let eye_v = &camera.v[0];
-            let qs_rev = to_area(scene, cam.pdf_dir(-w), eye_v, qs);
+            // The camera vertex of this strategy: the eye, or the lens point drawn here.
+            let eye_v = Vertex::at_point(Kind::Camera, eye, cam.forward(), Spectrum::ONE, 1.0);
+            let qs_rev = to_area(scene, cam.pdf_dir_from(eye, -w), &eye_v, qs);
             let qsm_rev = match qs.kind {
-                Kind::Surface(_) if s >= 2 => pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev,
+                Kind::Surface(_) | Kind::Medium(_) if s >= 2 => {
+                    pdf_at(scene, qs, qs.sh.frame.to_local(w), qs.sh.wo) * qs.g_prev
+                }
                 _ => 0.0,
             };
             mis_weight(scene, camera.v, 1, light.v, s, Overrides { pt_rev: 0.0, ptm_rev: 0.0, qs_rev, qsm_rev })
@@ -114,13 +131,17 @@ impl Bdpt {
             // The camera subpath escaped to the environment (its only light vertex).
             return if s == 0 { self.escaped(scene, camera, t, index, wl) } else { NONE };
         }
-        let Kind::Surface(object) = pt.kind else {
+        if !matches!(pt.kind, Kind::Surface(_) | Kind::Medium(_)) {
             return NONE;
+        }
+        let object = match pt.kind {
+            Kind::Surface(o) | Kind::Medium(o) => o,
+            _ => return NONE,
         };
         match s {
             0 => {
                 // The camera subpath ends on an emitter.
-                let Some(index) = scene.emitter(object) else {
+                let (Kind::Surface(_), Some(index)) = (pt.kind, scene.emitter(object)) else {
                     return NONE;
                 };
                 let light = scene.light(index);
@@ -155,20 +176,19 @@ impl Bdpt {
                     return NONE;
                 };
                 let light = scene.light(index);
-                let radiance = light.radiance(ls.wi);
                 let wi = pt.sh.frame.to_local(ls.wi);
-                if !pt.sh.consistent(ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
+                if !consistent_at(pt, ls.wi, wi) || ls.pdf.is_nan() || ls.pdf <= 0.0 {
                     return NONE;
                 }
-                let bxdf = bsdf_at(scene, object, pt);
-                let out = outside(scene, pt.outside);
-                let k = ls.scale * wi.z.abs() / (pmf * ls.pdf);
+                let k = ls.scale * cos_at(pt, wi) / (pmf * ls.pdf);
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
-                    let f = bxdf.eval_within(pt.sh.wo, wi, &one.lambdas, out)[0];
-                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * one.lambdas.sample(&radiance)[0] * k)
+                    let f = scatter_at(scene, pt, pt.sh.wo, wi, &one.lambdas)[0];
+                    let le = light.with_radiance(ls.wi, |s| one.lambdas.sample(s)[0]);
+                    Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * le * k)
                 } else {
-                    Contrib::Full(pt.beta * bxdf.eval_within(pt.sh.wo, wi, &Lambdas::full(), out) * *radiance * k)
+                    let f = scatter_at(scene, pt, pt.sh.wo, wi, &Lambdas::full());
+                    light.with_radiance(ls.wi, |s| Contrib::Full(pt.beta * f * *s * k))
                 };
                 if is_black(&c) {
                     return NONE;
@@ -183,8 +203,8 @@ impl Bdpt {
                 let pdf_y = if light.is_infinite() { pmf * pdf_dir } else { pmf * pdf_pos };
                 let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pdf_y);
                 let pt_rev = pdf_light(scene, &y, pt);
-                let ptm_rev = bxdf.pdf_within(wi, pt.sh.wo, &Lambdas::full(), out) * pt.g_prev;
-                let qs_rev = to_area(scene, bxdf.pdf_within(pt.sh.wo, wi, &Lambdas::full(), out), pt, &y);
+                let ptm_rev = pdf_at(scene, pt, wi, pt.sh.wo) * pt.g_prev;
+                let qs_rev = to_area(scene, pdf_at(scene, pt, pt.sh.wo, wi), pt, &y);
                 let overrides = Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev: 0.0 };
                 let weight = mis_weight(scene, camera.v, t, std::slice::from_ref(&y), 1, overrides);
                 scale(c, weight, transmittance, wl)
@@ -194,9 +214,9 @@ impl Bdpt {
                 if !connectible(scene, pt) || !connectible(scene, qs) {
                     return NONE;
                 }
-                let Kind::Surface(q_object) = qs.kind else {
+                if !matches!(qs.kind, Kind::Surface(_) | Kind::Medium(_)) {
                     return NONE;
-                };
+                }
                 let d = qs.p() - pt.p();
                 let d2 = d.length_squared();
                 if d2.is_nan() || d2 <= 0.0 {
@@ -204,21 +224,22 @@ impl Bdpt {
                 }
                 let w = d / d2.sqrt();
                 let (wi_p, wi_q) = (pt.sh.frame.to_local(w), qs.sh.frame.to_local(-w));
-                if !pt.sh.consistent(w, wi_p) || !qs.sh.consistent(-w, wi_q) {
+                if !consistent_at(pt, w, wi_p) || !consistent_at(qs, -w, wi_q) {
                     return NONE;
                 }
-                let (bp, bq) = (bsdf_at(scene, object, pt), bsdf_at(scene, q_object, qs));
-                let (op, oq) = (outside(scene, pt.outside), outside(scene, qs.outside));
-                let k = wi_p.z.abs() * wi_q.z.abs() / d2 * shading_correction(&qs.sh, -w, wi_q);
+                // Veach's shading-normal correction on the light side's surface (1 in a medium).
+                let correction =
+                    if matches!(qs.kind, Kind::Medium(_)) { 1.0 } else { shading_correction(&qs.sh, -w, wi_q) };
+                let k = cos_at(pt, wi_p) * cos_at(qs, wi_q) / d2 * correction;
                 let c = if pt.collapsed || qs.collapsed || is_dispersive(scene, pt) || is_dispersive(scene, qs) {
                     let one = wl.single();
-                    let fp = bp.eval_within(pt.sh.wo, wi_p, &one.lambdas, op)[0];
-                    let fq = bq.eval_within(wi_q, qs.sh.wo, &one.lambdas, oq)[0];
+                    let fp = scatter_at(scene, pt, pt.sh.wo, wi_p, &one.lambdas)[0];
+                    let fq = scatter_at(scene, qs, wi_q, qs.sh.wo, &one.lambdas)[0];
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * fp * fq * wl.at(&qs.beta, qs.collapsed) * k)
                 } else {
                     let full = Lambdas::full();
                     let (fp, fq) =
-                        (bp.eval_within(pt.sh.wo, wi_p, &full, op), bq.eval_within(wi_q, qs.sh.wo, &full, oq));
+                        (scatter_at(scene, pt, pt.sh.wo, wi_p, &full), scatter_at(scene, qs, wi_q, qs.sh.wo, &full));
                     Contrib::Full(pt.beta * fp * fq * qs.beta * k)
                 };
                 if is_black(&c) {
@@ -230,11 +251,10 @@ impl Bdpt {
                 };
                 // The four densities the connection changes, from the local
                 // directions already at hand (`wo` points back along each subpath).
-                let full = Lambdas::full();
-                let pt_rev = bq.pdf_within(qs.sh.wo, wi_q, &full, oq) * w.dot(pt.sh.n).abs() / d2;
-                let qs_rev = bp.pdf_within(pt.sh.wo, wi_p, &full, op) * w.dot(qs.sh.n).abs() / d2;
-                let ptm_rev = bp.pdf_within(wi_p, pt.sh.wo, &full, op) * pt.g_prev;
-                let qsm_rev = bq.pdf_within(wi_q, qs.sh.wo, &full, oq) * qs.g_prev;
+                let pt_rev = pdf_at(scene, qs, qs.sh.wo, wi_q) * cos_normal(pt, w) / d2;
+                let qs_rev = pdf_at(scene, pt, pt.sh.wo, wi_p) * cos_normal(qs, w) / d2;
+                let ptm_rev = pdf_at(scene, pt, wi_p, pt.sh.wo) * pt.g_prev;
+                let qsm_rev = pdf_at(scene, qs, wi_q, qs.sh.wo) * qs.g_prev;
                 let weight = mis_weight(scene, camera.v, t, light.v, s, Overrides { pt_rev, ptm_rev, qs_rev, qsm_rev });
                 scale(c, weight, transmittance, wl)
             }
@@ -253,12 +273,11 @@ impl Bdpt {
         let (pt, ptm) = (&camera.v[t - 1], &camera.v[t - 2]);
         let light = scene.light(index);
         let dir = (pt.p() - ptm.p()).normalize();
-        let le = light.radiance(dir);
         let c = if pt.collapsed {
             let one = wl.single();
-            Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(&le)[0])
+            Contrib::Single(pt.beta[one.slot] * light.with_radiance(dir, |s| one.lambdas.sample(s)[0]))
         } else {
-            Contrib::Full(pt.beta * *le)
+            Contrib::Full(light.with_radiance(dir, |s| pt.beta * *s))
         };
         if t == 2 {
             return c;

@@ -106,7 +106,7 @@ use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
 
-use super::Estimator;
+use super::{Estimator, camera_ray};
 use vertex::{Contrib, Kind, Vertex, Wavelength};
 use walk::Walk;
 
@@ -192,12 +192,18 @@ impl Estimator for Bdpt {
             } else if scene.has_environment() {
                 // Light tracing cannot reach the eye from infinity: the environment
                 // seen directly is the pixel ray's, unweighted (the only strategy).
-                let ray = scene.camera.ray(film);
-                if scene.intersect(&ray, f32::INFINITY).is_none()
-                    && scene.medium_in(scene.camera_volumes.current()).is_none()
-                    && let Some((_, le)) = scene.escaped(ray.dir)
+                // Through index-matched boundaries and false intersections, attenuated by
+                // the media on the way (the one visibility rule).
+                let ray = camera_ray(scene, film, sampler);
+                let far = ray.origin + ray.dir * (4.0 * scene.radius() + (ray.origin - scene.camera.eye()).length());
+                let volumes = scene.has_volumes().then_some(&scene.camera_volumes);
+                if let Some((_, le)) = scene.escaped(ray.dir)
+                    && let Some(clear) = scene.transmittance(ray.origin, Vec3::ZERO, volumes, far, -ray.dir)
                 {
-                    l += le;
+                    l += match clear.spectrum() {
+                        Some(t) => le * t,
+                        None => le,
+                    };
                 }
             }
             self.light_subpath(scene, sampler, light, track.then_some(&mut *light_media), &mut wl);
@@ -210,7 +216,7 @@ impl Estimator for Bdpt {
                         continue;
                     }
                     if t == 1 {
-                        if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, &mut wl) {
+                        if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, sampler, &mut wl) {
                             let value = match c {
                                 Contrib::Full(c) => O::from_packet(&full, &c),
                                 Contrib::Single(v) => O::from_packet(&wl.single().lambdas, &Sampled([v])),
@@ -246,12 +252,12 @@ impl Bdpt {
         wl: &mut Wavelength,
     ) {
         let cam = &scene.camera;
-        let ray = cam.ray(film);
+        let ray = camera_ray(scene, film, sampler);
         path.push(Vertex::at_point(Kind::Camera, ray.origin, cam.forward(), Spectrum::ONE, 1.0));
         if let Some(stacks) = stacks.as_deref_mut() {
             stacks.push(scene.camera_volumes);
         }
-        let pdf_dir = cam.pdf_dir(ray.dir);
+        let pdf_dir = cam.pdf_dir_from(ray.origin, ray.dir);
         let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2 };
         walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_volumes, wl);
     }
@@ -279,7 +285,7 @@ impl Bdpt {
             return;
         }
         let infinite = light.is_infinite();
-        let beta0 = *light.radiance(-e.dir) / pdf_origin;
+        let beta0 = light.with_radiance(-e.dir, |s| *s / pdf_origin);
         // The environment's first vertex is a direction: its density is the
         // direction's (per solid angle), as a camera subpath escaping along it sees it.
         let pdf_y0 = if infinite { pmf * e.pdf_dir } else { pdf_origin };

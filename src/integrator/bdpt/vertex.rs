@@ -1,7 +1,6 @@
 //! Subpath vertices, the sample's collapsed wavelength, and the densities and
 //! material queries a vertex answers.
 
-use std::borrow::Cow;
 use std::sync::LazyLock;
 
 use glam::{Vec2, Vec3};
@@ -23,6 +22,8 @@ pub(super) enum Kind {
     Light(u32),
     /// A surface point of object `index`.
     Surface(u32),
+    /// A scattering event in the medium filling object `index`'s inside.
+    Medium(u32),
 }
 
 /// A subpath vertex.
@@ -92,7 +93,7 @@ impl Vertex {
         match self.kind {
             Kind::Surface(_) => true,
             Kind::Light(i) => !scene.light(i).is_delta(),
-            Kind::Camera => false,
+            Kind::Camera | Kind::Medium(_) => false,
         }
     }
 }
@@ -166,10 +167,11 @@ pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
     scene.bsdf(o)
 }
 
-/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the vertex's (u, v)).
-#[inline]
-pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex) -> Cow<'s, Bxdf> {
-    scene.bsdf_uv(o, v.uv)
+/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the
+/// vertex's (u, v), built in `slot`).
+#[inline(always)]
+pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex, slot: &'s mut Option<Bxdf>) -> &'s Bxdf {
+    scene.bsdf_uv(o, v.uv, slot)
 }
 
 /// True when a connection can end at `v`: a surface whose material has a
@@ -180,7 +182,7 @@ pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex) -> Cow<'s, Bxdf>
 pub(super) fn connectible(scene: &Scene, v: &Vertex) -> bool {
     match v.kind {
         Kind::Surface(o) => !material(scene, o).is_delta(),
-        Kind::Light(_) | Kind::Camera => true,
+        Kind::Light(_) | Kind::Camera | Kind::Medium(_) => true,
     }
 }
 
@@ -222,9 +224,75 @@ pub(super) fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -
 #[inline]
 pub(super) fn pdf_at(scene: &Scene, v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
     match v.kind {
-        Kind::Surface(o) => bsdf_at(scene, o, v).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside)),
+        Kind::Surface(o) => {
+            let mut slot = None;
+            bsdf_at(scene, o, v, &mut slot).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside))
+        }
+        Kind::Medium(o) => scene.interior(o).map_or(0.0, |m| m.phase().eval(wo, wi)),
         _ => 0.0,
     }
+}
+
+/// A medium vertex at `p` in the medium filling object `object`, reached
+/// travelling along `dir`: its frame's z is `−dir`, so its local `wo` is +z
+/// (the phase function depends only on the angle, so any frame serves); no
+/// normal (no cosine, no ray offset).
+pub(super) fn medium_vertex(object: u32, p: Vec3, dir: Vec3, beta: Spectrum, collapsed: bool) -> Vertex {
+    let sh = Shading { p, n: Vec3::ZERO, frame: Frame::from_z(-dir), wo: Vec3::Z, wo_n: 0.0 };
+    Vertex {
+        kind: Kind::Medium(object),
+        sh,
+        beta,
+        delta: false,
+        collapsed,
+        pdf_fwd: 0.0,
+        pdf_rev: 0.0,
+        g_prev: 0.0,
+        outside: None,
+        uv: Vec2::ZERO,
+    }
+}
+
+/// What a vertex that scatters does between local directions `wo` and `wi`
+/// for the packet: its BSDF on a surface (its texture evaluated), its phase
+/// function in a medium. Zero for light and eye vertices.
+#[inline]
+pub(super) fn scatter_at<const N: usize>(
+    scene: &Scene,
+    v: &Vertex,
+    wo: Vec3,
+    wi: Vec3,
+    lambdas: &Lambdas<N>,
+) -> crate::color::Sampled<N> {
+    match v.kind {
+        Kind::Surface(o) => {
+            let mut slot = None;
+            bsdf_at(scene, o, v, &mut slot).eval_within(wo, wi, lambdas, outside(scene, v.outside))
+        }
+        Kind::Medium(o) => crate::color::Sampled::splat(scene.interior(o).map_or(0.0, |m| m.phase().eval(wo, wi))),
+        _ => crate::color::Sampled::splat(0.0),
+    }
+}
+
+/// The cosine a scattering vertex contributes for local direction `wi`:
+/// `|cos θ|` on a surface, 1 in a medium.
+#[inline]
+pub(super) fn cos_at(v: &Vertex, wi: Vec3) -> f32 {
+    if matches!(v.kind, Kind::Medium(_)) { 1.0 } else { wi.z.abs() }
+}
+
+/// `|w · n|` at vertex `v` when densities arriving there carry its cosine
+/// (a surface), else 1 (a medium point).
+#[inline]
+pub(super) fn cos_normal(v: &Vertex, w: Vec3) -> f32 {
+    if matches!(v.kind, Kind::Medium(_)) { 1.0 } else { w.dot(v.sh.n).abs() }
+}
+
+/// Whether world direction `w` (local `wi`) leaves vertex `v` on the side its
+/// shading frame claims ([`Shading::consistent`] on a surface; always in a medium).
+#[inline]
+pub(super) fn consistent_at(v: &Vertex, w: Vec3, wi: Vec3) -> bool {
+    matches!(v.kind, Kind::Medium(_)) || v.sh.consistent(w, wi)
 }
 
 /// The area density at `next` of the ray `sample_le` would start from light

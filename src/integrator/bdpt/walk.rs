@@ -10,7 +10,7 @@ use crate::scene::Scene;
 use crate::spectral::Lambdas;
 
 use super::RR_DEPTH;
-use super::vertex::{Kind, Vertex, Wavelength, outside, shading_correction, to_area};
+use super::vertex::{Kind, Vertex, Wavelength, medium_vertex, outside, shading_correction, to_area};
 
 /// A subpath walk's fixed parameters.
 pub(super) struct Walk {
@@ -66,10 +66,66 @@ impl Walk {
             let hit = si.hit;
             let textured = scene.texture(si.object).is_some();
             let uv = if textured { scene.uv(&si) } else { glam::Vec2::ZERO };
-            let bxdf = scene.bsdf_uv(si.object, uv);
-            // Beer-Lambert along the segment, in the medium it ran in.
-            if let Some(medium) = scene.medium_in(media.current()) {
-                if collapsed {
+            let mut slot = None;
+            let bxdf = scene.bsdf_uv(si.object, uv, &mut slot);
+            // The medium the segment ran in: Beer-Lambert where it only absorbs;
+            // where it scatters (or is a grid), a distance by spectral MIS, and a
+            // scattering event before the surface is a medium vertex.
+            if let Some(volume) = media.current()
+                && let Some(medium) = scene.medium_in(Some(volume))
+            {
+                if medium.scatters() || medium.is_grid() {
+                    let u = sampler.get_1d(Dim::medium_distance(bounces).on_light_path_if(self.importance));
+                    let (t, scattered) = if collapsed {
+                        let one = wl.single();
+                        let d = medium.sample_distance_along(ray.origin, ray.dir, hit.t, &one.lambdas, u);
+                        beta[one.slot] *= d.weight[0];
+                        (d.t, d.scattered)
+                    } else {
+                        let d = medium.sample_distance_along(ray.origin, ray.dir, hit.t, &full, u);
+                        beta *= d.weight;
+                        (d.t, d.scattered)
+                    };
+                    if scattered {
+                        if beta.is_black() {
+                            break;
+                        }
+                        let p = ray.at(t);
+                        let prev = path.last().expect("a subpath starts at the eye or a light");
+                        let mut v = medium_vertex(volume.object, p, ray.dir, beta, collapsed);
+                        // A medium point carries no cosine: a parallel light's disk density as it is.
+                        v.pdf_fwd = if parallel { pdf_dir } else { to_area(scene, pdf_dir, prev, &v) };
+                        v.g_prev = to_area(scene, 1.0, &v, prev);
+                        parallel = false;
+                        path.push(v);
+                        if let Some(stacks) = stacks.as_deref_mut() {
+                            stacks.push(media);
+                        }
+                        if path.len() >= self.max_vertices {
+                            break;
+                        }
+                        // The phase function's direction: weight 1, symmetric density.
+                        let u2 = sampler.get_2d(Dim::bsdf(bounces).on_light_path_if(self.importance));
+                        let (wi, pdf) = medium.phase().sample(-ray.dir, u2);
+                        let n = path.len();
+                        path[n - 2].pdf_rev = pdf * path[n - 1].g_prev;
+                        pdf_dir = pdf;
+                        bounces += 1;
+                        if bounces >= RR_DEPTH {
+                            let q = (beta.max_value() * eta_scale / beta_ref).min(1.0);
+                            if sampler.get_1d_if(q < 1.0, Dim::roulette(bounces - 1).on_light_path_if(self.importance))
+                                >= q
+                                || q.is_nan()
+                            {
+                                break;
+                            }
+                            beta /= q;
+                        }
+                        ray = Ray::new(p, wi);
+                        passes = 0;
+                        continue;
+                    }
+                } else if collapsed {
                     let one = wl.single();
                     beta[one.slot] *= medium.transmittance(hit.t, &one.lambdas)[0];
                 } else {
@@ -83,7 +139,7 @@ impl Walk {
             let mut outside_material = None;
             if let Some(m) = scene.volume(si.object) {
                 let entering = ray.dir.dot(hit.n) < 0.0;
-                match media.crossing(m, entering) {
+                match scene.crossing(&media, m, entering) {
                     Crossing::Pass => {
                         media.cross(m, entering);
                         passes += 1;

@@ -85,6 +85,8 @@ pub(crate) enum Tex {
 /// The camera as given, resolved at `WorldBegin` (the film's size is known then).
 struct PendingCamera {
     fov: f64,
+    lens_radius: f64,
+    focal_distance: f64,
     camera_from_world: DMat4,
     loc: Loc,
 }
@@ -468,10 +470,11 @@ impl Parser<'_> {
         if !(fov > 0.0 && fov < 180.0) {
             return Err(self.err(at, format!("Camera \"fov\": expected degrees in (0, 180), found {fov}")));
         }
-        if self.float(ps, "lensradius", 0.0)? > 0.0 {
-            self.warn(at, "Camera \"lensradius\": depth of field is not supported yet (a pinhole camera)")?;
+        let lens_radius = self.float(ps, "lensradius", 0.0)?;
+        let focal_distance = self.float(ps, "focaldistance", 1e6)?;
+        if !(lens_radius >= 0.0 && focal_distance > 0.0) {
+            return Err(self.err(at, format!("Camera: expected \"lensradius\" ≥ 0 and \"focaldistance\" > 0, found {lens_radius} and {focal_distance}")));
         }
-        self.float(ps, "focaldistance", 1e6)?;
         if let Some(p) = self.param(ps, "screenwindow") {
             let loc = p.loc;
             self.warn(loc, "Camera \"screenwindow\" is not supported: the full frame is rendered")?;
@@ -486,7 +489,8 @@ impl Parser<'_> {
                 self.warn(loc, format!("Camera \"{t}\": motion blur is not supported (ignored)"))?;
             }
         }
-        self.built.pending_camera = Some(PendingCamera { fov, camera_from_world: ctm, loc: at });
+        self.built.pending_camera =
+            Some(PendingCamera { fov, lens_radius, focal_distance, camera_from_world: ctm, loc: at });
         Ok(())
     }
 
@@ -580,6 +584,8 @@ impl Parser<'_> {
     pub(crate) fn begin_world(&mut self, loc: Loc) -> Result<()> {
         let cam = self.built.pending_camera.take().unwrap_or(PendingCamera {
             fov: 90.0,
+            lens_radius: 0.0,
+            focal_distance: 1e6,
             camera_from_world: DMat4::IDENTITY,
             loc,
         });
@@ -614,7 +620,12 @@ impl Parser<'_> {
             eye: f3(m.transform_point3(eye)),
             look_at: f3(m.transform_point3(eye + forward.normalize())),
             up: f3(m.transform_vector3(up.normalize())),
-            fov_deg: fov as f32,
+            fov_deg: Some(fov as f32),
+            // pbrt's thin lens: a disk of `lensradius` in scene units, focused at
+            // `focaldistance` along the view direction.
+            aperture_radius: cam.lens_radius as f32,
+            focus_distance: (cam.lens_radius > 0.0).then_some(cam.focal_distance as f32),
+            lens: None,
         });
         Ok(())
     }
@@ -1107,7 +1118,15 @@ impl Parser<'_> {
                 area: rec.area.clone(),
             });
         }
-        self.built.objects.push(ObjectDesc { shape, material, emission, two_sided, priority: 0, transform: None });
+        self.built.objects.push(ObjectDesc {
+            shape,
+            material,
+            emission,
+            two_sided,
+            priority: 0,
+            transform: None,
+            interior: None,
+        });
         self.built.mesh_files.push(mesh_file);
         Ok(())
     }

@@ -19,7 +19,7 @@ use std::path::Path;
 
 use crate::error::Result;
 use crate::scene::check::Check;
-use crate::scene::desc::{Materials, SceneDesc};
+use crate::scene::desc::{NamedMap, SceneDesc};
 
 pub use write::convert;
 
@@ -68,7 +68,8 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
         desc: SceneDesc {
             camera,
             render: b.render,
-            materials: Materials(b.materials),
+            materials: NamedMap(b.materials),
+            media: NamedMap(Vec::new()),
             objects: b.objects,
             lights: b.lights,
             environment: b.environment,

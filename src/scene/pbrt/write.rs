@@ -14,7 +14,9 @@ use super::Imported;
 use crate::error::{Error, Result, show_path};
 use crate::io::{MeshData, read_input, write_atomic};
 use crate::scene::check::Check;
-use crate::scene::desc::{CameraDesc, EnvironmentDesc, LightDesc, Materials, ObjectDesc, ShapeDesc, SpectrumDesc};
+use crate::scene::desc::{
+    CameraDesc, EnvironmentDesc, LightDesc, Materials, MediumDesc, NamedMap, ObjectDesc, ShapeDesc, SpectrumDesc,
+};
 use crate::settings::{IntegratorKind, SettingsPatch};
 
 /// The `render:` block as written.
@@ -52,11 +54,17 @@ struct Out<'a> {
     camera: &'a CameraDesc,
     render: Render,
     materials: &'a Materials,
+    #[serde(skip_serializing_if = "is_empty")]
+    media: &'a NamedMap<MediumDesc>,
     objects: &'a [ObjectDesc],
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     lights: &'a [LightDesc],
     #[serde(skip_serializing_if = "Option::is_none")]
     environment: &'a Option<EnvironmentDesc>,
+}
+
+fn is_empty(m: &&NamedMap<MediumDesc>) -> bool {
+    m.0.is_empty()
 }
 
 fn render(p: &SettingsPatch) -> Render {
@@ -203,6 +211,7 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         camera: &desc.camera,
         render: render(&desc.render),
         materials: &desc.materials,
+        media: &desc.media,
         objects: &desc.objects,
         lights: &desc.lights,
         environment: &desc.environment,
