@@ -20,6 +20,7 @@ mod media;
 mod memory;
 mod metrics;
 mod output;
+mod pbrt;
 mod sampler;
 mod scenes;
 mod spectra;

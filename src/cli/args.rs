@@ -24,7 +24,7 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Render a RON scene file to a 16-bit sRGB PNG (or a linear EXR).
+    /// Render a scene file (RON, or pbrt-v4 `.pbrt`) to a 16-bit sRGB PNG (or a linear EXR).
     ///
     /// While it runs: SIGUSR1 writes a PNG snapshot (NAME-00128.png), SIGUSR2
     /// a checkpoint, SIGINT/SIGTERM both and then exit 0.
@@ -38,6 +38,22 @@ pub enum Command {
     /// Convergence study: render progressively with several methods and seeds, measure
     /// against a reference at checkpoints, write CSVs and charts.
     Converge(ConvergeArgs),
+    /// Convert a pbrt-v4 scene file to a RON scene that renders the same image bit for bit.
+    Convert(ConvertArgs),
+}
+
+/// Flags of `convert`.
+#[derive(Debug, Args)]
+pub struct ConvertArgs {
+    /// The pbrt-v4 scene file (`.pbrt`).
+    pub scene: PathBuf,
+    /// The RON scene to write; meshes read from PLY files are written beside it
+    /// (`NAME-mesh-K.ply`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Anything in the pbrt file that is not understood is an error instead of a warning.
+    #[arg(long)]
+    pub strict: bool,
 }
 
 /// Flags of `compare`.
@@ -96,8 +112,11 @@ pub struct RunArgs {
 /// Flags of `render`. Settings given here override the scene file's `render` block.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// The scene file (RON).
+    /// The scene file: RON, or pbrt-v4 when its name ends in `.pbrt`.
     pub scene: PathBuf,
+    /// With a `.pbrt` scene: anything not understood is an error instead of a warning.
+    #[arg(long)]
+    pub strict: bool,
     /// Output image: `.png` (16-bit sRGB) or `.exr` (linear sRGB, float). Default: the scene's name with `.png`, in the current directory.
     #[arg(short, long)]
     pub output: Option<PathBuf>,

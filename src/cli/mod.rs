@@ -5,12 +5,14 @@
 //! - [`render`]: `render`, `resume` and `merge`; a render runs through
 //!   [`session`] (signals, snapshots, checkpoints, the final outputs);
 //! - [`study`]: `compare` and `converge`, the faces of [`rust_v::study`];
+//! - [`convert`]: `convert`, a pbrt-v4 scene to RON;
 //! - [`console`]: what the user sees on stderr while it runs.
 //!
 //! `main` only parses, calls [`run`], prints the error and picks the exit code.
 
 pub mod args;
 mod console;
+mod convert;
 mod memory;
 mod render;
 mod session;
@@ -28,5 +30,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Merge(args) => render::merge_command(args),
         Command::Compare(args) => study::compare_command(args),
         Command::Converge(args) => study::converge_command(args),
+        Command::Convert(args) => convert::convert_command(args),
     }
 }

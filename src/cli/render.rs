@@ -15,7 +15,7 @@ use rust_v::color::{ColorSpace, Tonemap};
 use rust_v::error::{Error, Result, show_path};
 use rust_v::film::{Film, MAX_SAMPLE};
 use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, parent_dir};
-use rust_v::scene::{Scene, load_scene};
+use rust_v::scene::{Scene, load_scene_with_warnings};
 
 use super::args::{MergeArgs, RenderArgs, ResumeArgs};
 use super::console::{count, say, thread_pool, warn};
@@ -39,7 +39,11 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     }
     let load_start = Instant::now();
     // Loading (meshes are read and built in parallel) uses the threads asked for too.
-    let scene = thread_pool(args.run.threads)?.install(|| load_scene(&args.scene, &args.settings.overrides()))?;
+    let (scene, warnings) = thread_pool(args.run.threads)?
+        .install(|| load_scene_with_warnings(&args.scene, &args.settings.overrides(), args.strict))?;
+    for w in &warnings {
+        warn(format_args!("{w}"));
+    }
     let load_time = load_start.elapsed();
     let s = &scene.settings;
     if args.spectral
@@ -128,8 +132,9 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     ckpt.film.set_color_space(args.color_space);
     ckpt.film.set_picture(args.picture.exposure, args.picture.tonemap);
     let scene = thread_pool(args.run.threads)?
-        .install(|| load_scene(&ckpt.scene_path, &ckpt.settings.patch()))
-        .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?;
+        .install(|| load_scene_with_warnings(&ckpt.scene_path, &ckpt.settings.patch(), false))
+        .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?
+        .0;
     if scene.content_hash != ckpt.content_hash {
         let changed = match &ckpt.inputs {
             Some(old) => {

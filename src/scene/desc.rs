@@ -24,7 +24,7 @@
 
 use std::collections::BTreeSet;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::settings::SettingsPatch;
 
@@ -59,7 +59,7 @@ pub struct SceneDesc {
 }
 
 /// The scene's `environment:`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum EnvironmentDesc {
     /// The same radiance from every direction: `Uniform(Constant(1))`.
@@ -108,11 +108,30 @@ fn one() -> f32 {
     1.0
 }
 
+fn is_zero(v: &u32) -> bool {
+    *v == 0
+}
+
+fn is_zero_f32(v: &f32) -> bool {
+    *v == 0.0
+}
+
 /// A map from names to descriptions in file order (`materials`, `media`); a
 /// name given twice is an error (`duplicate material "white"`), where a plain
 /// map would keep the last.
 #[derive(Debug)]
 pub struct NamedMap<T>(pub Vec<(String, T)>);
+
+impl<T: Serialize> Serialize for NamedMap<T> {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.0.len()))?;
+        for (name, m) in &self.0 {
+            map.serialize_entry(name, m)?;
+        }
+        map.end()
+    }
+}
 
 /// The `materials` map.
 pub type Materials = NamedMap<MaterialDesc>;
@@ -162,7 +181,7 @@ impl<'de, T: Deserialize<'de> + Noun> Deserialize<'de> for NamedMap<T> {
 }
 
 /// A participating medium (`crate::medium`): coefficients per scene unit.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum MediumDesc {
     /// The same everywhere:
@@ -196,7 +215,7 @@ pub enum MediumDesc {
 }
 
 /// A medium's phase function.
-#[derive(Clone, Copy, Debug, Default, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum PhaseDesc {
     /// The same in every direction (the default).
@@ -211,7 +230,7 @@ pub enum PhaseDesc {
 }
 
 /// A pinhole camera, a thin lens with depth of field, or a lens system.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
     /// Position of the eye.
@@ -226,20 +245,20 @@ pub struct CameraDesc {
     #[serde(default)]
     pub fov_deg: Option<f32>,
     /// The thin lens's radius in scene units (default 0: a pinhole, no depth of field).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero_f32")]
     pub aperture_radius: f32,
     /// The distance of the plane in focus along the view direction (default:
     /// from `eye` to `look_at`).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub focus_distance: Option<f32>,
     /// A lens system in front of a film, instead of the pinhole or thin lens.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lens: Option<LensDesc>,
 }
 
 /// A lens system camera: a lens file (pbrt's format, with an optional glass
 /// column) and its settings.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LensDesc {
     /// The lens file, relative to the scene file.
@@ -262,7 +281,7 @@ fn default_up() -> V3 {
 }
 
 /// A spectrum in the scene file.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 pub enum SpectrumDesc {
     /// The same value at every wavelength: `Constant(0.5)`.
     Constant(f32),
@@ -324,7 +343,7 @@ pub enum SpectrumDesc {
 }
 
 /// How an image texture continues outside [0, 1].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 pub enum Wrap {
     /// Periodically (the default).
     #[default]
@@ -338,7 +357,7 @@ fn ones2() -> [f32; 2] {
 }
 
 /// An index of refraction in the scene file.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum IorDesc {
     /// Constant over wavelength: `Constant(1.5)`.
@@ -362,7 +381,7 @@ pub enum IorDesc {
 }
 
 /// A material.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum MaterialDesc {
     /// Ideal diffuse.
@@ -391,10 +410,10 @@ pub enum MaterialDesc {
         #[serde(default)]
         roughness: f32,
         /// Absorption coefficient inside, per scene unit (default: clear).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         absorption: Option<SpectrumDesc>,
         /// A thin film on the outside (on every microfacet of rough glass): `coating: ThinFilm(thickness_nm: 100, ior: Constant(1.38))`.
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         coating: Option<CoatingDesc>,
     },
     /// A metal: `Conductor(metal: "Au")` (Au, Ag, Cu, Al, Cr, CuZn) or
@@ -402,19 +421,19 @@ pub enum MaterialDesc {
     /// (GGX α as Mitsuba's `alpha`; 0, the default, is a smooth metal).
     Conductor {
         /// A named metal (exclusive with `eta` and `k`).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         metal: Option<String>,
         /// The real part of the complex index, per wavelength.
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         eta: Option<SpectrumDesc>,
         /// The extinction coefficient (imaginary part), per wavelength.
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         k: Option<SpectrumDesc>,
         /// GGX α in [0, 1] (default 0: smooth).
         #[serde(default)]
         roughness: f32,
         /// A thin film on the metal: `coating: ThinFilm(thickness_nm: 300, ior: Constant(1.45))`.
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         coating: Option<CoatingDesc>,
     },
     /// Coated diffuse: a dielectric coat (index `ior`, GGX `roughness`,
@@ -443,7 +462,7 @@ pub enum MaterialDesc {
 }
 
 /// A coating on a surface.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum CoatingDesc {
     /// A thin film of `thickness_nm` and index `ior` (interference per wavelength).
@@ -456,7 +475,7 @@ pub enum CoatingDesc {
 }
 
 /// A shape.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum ShapeDesc {
     /// A sphere.
@@ -515,11 +534,11 @@ pub enum ShapeDesc {
         /// Triangles as indices into `positions`, counter-clockwise seen from the front.
         indices: Vec<[u32; 3]>,
         /// Per-vertex shading normals, one per position (default: flat triangles).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         normals: Option<Vec<V3>>,
         /// Per-vertex texture coordinates `(u, v)`, one per position (kept for textures,
         /// issue 35; default: none).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         uvs: Option<Vec<[f32; 2]>>,
     },
     /// A triangle mesh from an OBJ or PLY file (optionally .gz), relative to the scene file.
@@ -527,19 +546,19 @@ pub enum ShapeDesc {
         /// The mesh file.
         path: String,
         /// Uniform or per-axis scale (default 1).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         scale: Option<ScaleDesc>,
         /// Rotation in degrees about x, then y, then z (default none).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         rotate_deg: Option<V3>,
         /// Translation (default none).
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         translate: Option<V3>,
     },
 }
 
 /// A scale: one number or three.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(untagged)]
 pub enum ScaleDesc {
     /// The same along every axis.
@@ -549,34 +568,34 @@ pub enum ScaleDesc {
 }
 
 /// An object: a shape with a material, an emission, or both.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectDesc {
     /// The shape.
     pub shape: ShapeDesc,
     /// The name of a material in `materials` (default: black, for lights).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// Emitted radiance, making the object an area light (spheres, disks,
     /// quads, cuboids and meshes).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<SpectrumDesc>,
     /// Whether the emission leaves both sides of the surface (default false:
     /// only the side the normal points to, outward for a sphere).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub two_sided: bool,
     /// For a dielectric object: which medium wins where its volume overlaps
     /// another's (default 0; higher wins; nested dielectrics, see
     /// [`crate::medium::nested`]; ignored for other materials): `priority: 2`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub priority: u32,
     /// Where to place the shape: `transform: (scale: 2, rotate_deg: (0, 45, 0), translate: (1, 0, 0))`
     /// (default: as given). See [`TransformDesc`] for what each shape accepts.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<TransformDesc>,
     /// The name of a medium in `media` filling the object's inside (its
     /// material must be a `Dielectric` or an `Interface`): `interior: "milk"`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interior: Option<String>,
 }
 
@@ -588,22 +607,22 @@ pub struct ObjectDesc {
 /// ellipsoid, a scaled disk an ellipse); planes and quads take any scale; a cuboid
 /// with a rotation becomes a closed mesh of 12 triangles (still a solid for nested
 /// dielectrics), without one it stays an axis-aligned box.
-#[derive(Clone, Debug, Default, Deserialize)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TransformDesc {
     /// Uniform or per-axis scale, positive (default 1).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scale: Option<ScaleDesc>,
     /// Rotation in degrees about x, then y, then z (default none).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotate_deg: Option<V3>,
     /// Translation (default none).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub translate: Option<V3>,
 }
 
 /// A light that is not an object.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub enum LightDesc {
     /// A point light.

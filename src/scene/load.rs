@@ -29,9 +29,24 @@ use crate::shape::{Mesh, MeshAhead, Placement, Shape};
 /// precedence over the file's `render` settings. The file must be a regular
 /// file of UTF-8 text (a byte-order mark is allowed).
 pub fn load_scene(path: &Path, overrides: &SettingsPatch) -> Result<Scene> {
+    load_scene_with_warnings(path, overrides, false).map(|(scene, _)| scene)
+}
+
+/// Loads the scene file at `path` as [`load_scene`] does, and returns the
+/// warnings of its reader too, one line each (`FILE:LINE:COL: message`). A
+/// path ending in `.pbrt` (any case) is read as a pbrt-v4 scene
+/// ([`super::pbrt`]); `strict` then turns every warning into an error. RON
+/// scenes have no warnings at load.
+pub fn load_scene_with_warnings(path: &Path, overrides: &SettingsPatch, strict: bool) -> Result<(Scene, Vec<String>)> {
     let bytes = read_input(path)?;
     let text = decode_text(&bytes, path)?;
-    load(text, &bytes, path, overrides)
+    if super::pbrt::is_pbrt(path) {
+        let ctx = Check::new(path);
+        let imported = super::pbrt::import(&ctx, path, text, strict)?;
+        let scene = build(&ctx, imported.desc, overrides)?;
+        return Ok((identify(scene, ctx, &bytes), imported.warnings));
+    }
+    Ok((load(text, &bytes, path, overrides)?, Vec::new()))
 }
 
 /// Loads a scene from its text; `path` names it in errors and anchors
@@ -58,7 +73,12 @@ fn load(text: &str, bytes: &[u8], path: &Path, overrides: &SettingsPatch) -> Res
         }
     })?;
     let ctx = Check::new(path);
-    let mut scene = build(&ctx, desc, overrides).map_err(|e| locate(e, text))?;
+    let scene = build(&ctx, desc, overrides).map_err(|e| locate(e, text))?;
+    Ok(identify(scene, ctx, bytes))
+}
+
+/// The scene with its identity: the hashes of its file and of every file it read.
+fn identify(mut scene: Scene, ctx: Check<'_>, bytes: &[u8]) -> Scene {
     let inputs = ctx.inputs.into_inner();
     scene.content_hash = content_hash(bytes, &inputs);
     scene.input_hashes = crate::checkpoint::InputHashes {
@@ -66,7 +86,7 @@ fn load(text: &str, bytes: &[u8], path: &Path, overrides: &SettingsPatch) -> Res
         files: inputs.iter().map(|i| (i.name.clone(), i.hash)).collect(),
     };
     scene.inputs = inputs.into_iter().map(|i| i.path).collect();
-    Ok(scene)
+    scene
 }
 
 /// The scene's identity for checkpoints: the FNV-1a hash of its file, and

@@ -10,11 +10,12 @@
 pub(crate) mod check;
 pub mod desc;
 mod load;
+pub mod pbrt;
 mod position;
 mod query;
 mod spectra;
 
-pub use load::{load_scene, load_scene_str};
+pub use load::{load_scene, load_scene_str, load_scene_with_warnings};
 pub use query::{Clear, Emitted, LightChoice, MAX_PASSES};
 
 use crate::bxdf::Bxdf;

@@ -1,0 +1,80 @@
+//! pbrt-v4 scene files (`.pbrt`): a second reader of the format-neutral scene
+//! description. `lexer` makes tokens, `parser` reads directives, parameter
+//! lists, the graphics state and transforms (with `Include`/`Import`), and
+//! `map` turns each pbrt entity into its [`SceneDesc`] counterpart; the
+//! scene is then built exactly like a RON scene. `write` is `rust-v convert`:
+//! the same description written as RON.
+//!
+//! What is supported, mapped, warned about and refused is in `docs/pbrt.md`.
+//! Anything not understood gives a warning (`FILE:LINE:COL: ...`, once per
+//! message with a count of further uses), or with `strict` an error.
+
+mod lexer;
+mod loop_subdiv;
+mod map;
+mod parser;
+mod write;
+
+use std::path::Path;
+
+use crate::error::Result;
+use crate::scene::check::Check;
+use crate::scene::desc::{NamedMap, SceneDesc};
+
+pub use write::convert;
+
+/// A pbrt scene read into a description.
+pub(crate) struct Imported {
+    /// The scene description.
+    pub(crate) desc: SceneDesc,
+    /// Warnings, one line each (`FILE:LINE:COL: message`).
+    pub(crate) warnings: Vec<String>,
+    /// Per object: the PLY file its triangles came from, if any.
+    pub(crate) mesh_files: Vec<Option<String>>,
+}
+
+/// Whether `path` names a pbrt scene (`.pbrt`, any case).
+pub fn is_pbrt(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("pbrt"))
+}
+
+/// Reads the pbrt scene file at `path` into its scene description, with the
+/// warnings (one line each); `strict` makes every warning an error. Geometry is in
+/// rust-v's world space: mirrored `x → −x` when pbrt's camera space needs it (see
+/// `docs/pbrt.md`, Handedness).
+pub fn read_pbrt(path: &Path, strict: bool) -> Result<(SceneDesc, Vec<String>)> {
+    let bytes = crate::io::read_input(path)?;
+    let text = std::str::from_utf8(bytes.strip_prefix(&[0xef, 0xbb, 0xbf]).unwrap_or(&bytes)).map_err(|e| {
+        crate::error::Error::scene_field(
+            path,
+            "",
+            format!("byte {} is not UTF-8; expected UTF-8 text", e.valid_up_to()),
+        )
+    })?;
+    let ctx = Check::new(path);
+    let imported = import(&ctx, path, text, strict)?;
+    Ok((imported.desc, imported.warnings))
+}
+
+/// Reads the pbrt scene `text` of the file `path`; files it reads are recorded in `ctx`.
+pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> Result<Imported> {
+    let mut p = parser::Parser::new(ctx, path, text.to_string(), strict);
+    p.run()?;
+    p.resolve_plys()?;
+    let warnings = p.warning_lines();
+    let b = std::mem::take(&mut p.built);
+    let camera = b.camera.ok_or_else(|| crate::error::Error::scene_field(path, "", "the file has no WorldBegin"))?;
+    Ok(Imported {
+        desc: SceneDesc {
+            camera,
+            render: b.render,
+            materials: NamedMap(b.materials),
+            media: NamedMap(Vec::new()),
+            objects: b.objects,
+            lights: b.lights,
+            environment: b.environment,
+        },
+        warnings,
+        mesh_files: b.mesh_files,
+    })
+}
