@@ -42,6 +42,7 @@ fn main() {
             px.extend_from_slice(&rgb);
         }
     }
+    std::fs::create_dir_all("scenes/textures").unwrap();
     image::Rgb32FImage::from_raw(w, h, px).unwrap().save("scenes/textures/outdoor.exr").unwrap();
 
     // Approximate sRGB (8-bit) of the 24 ColorChecker patches, row by row.
