@@ -23,9 +23,11 @@ blocks' z spread like a standard normal.
 
     ~/.cache/peers/mitsuba-venv/bin/python scripts/peer_media.py [--bin target/release/rust-v]
         [--seeds 4] [--mitsuba-spp 2048] [--rustv-spp 2048] [--scenes medium,plain]
-        [--variant llvm_ad_spectral] [--integrator volpath] [--out DIR] [--compare-only]
+        [--variant llvm_ad_spectral] [--integrator volpath] [--out DIR] [--compare-only] [--speed ROUNDS]
 
-(scripts/peer_media.sh runs it with the venv's python.) Images go to DIR (default
+--speed ROUNDS then measures time to equal error on the medium scene (Mitsuba `volpath` and
+`volpathmis` at 64 spp against the mean of Mitsuba's images, rust-v against the mean of its own;
+see speed()). (scripts/peer_media.sh runs it with the venv's python.) Images go to DIR (default
 /tmp/peer-media) and are reused when there (delete DIR to render afresh; a run with more
 --seeds renders only the new ones); --compare-only renders nothing. Prints markdown tables.
 """
@@ -287,6 +289,81 @@ def effect(results, a):
     return "\n".join(lines) + "\n"
 
 
+def speed(a, res):
+    """Time to equal error on the medium scene: per round, Mitsuba (`volpath` and `volpathmis`) at
+    64 spp against Mitsuba's reference (the mean of the accuracy run's images), and rust-v at
+    increasing spp until its linear MSE against its own reference is at most the better
+    integrator's; rust-v's time is its spp times its mean time per spp over the round's renders."""
+    import math
+    refs = {}
+    for r in ("mitsuba", "rust-v"):
+        refs[r] = res[r][0].mean(axis=0)
+    ron = os.path.join(HERE, "scenes", "cornell-medium.ron")
+
+    def mse(img, r):
+        return float(((img - refs[r]) ** 2).mean())
+
+    def rustv(n, seed):
+        exr = os.path.join(a.out, f"speed-rustv-{n}-s{seed}.exr")
+        r = subprocess.run([a.bin, "render", ron, "--spp", str(n), "--seed", str(seed), "--width", str(RES),
+                            "--height", str(RES), "--integrator", a.rustv_integrator, "-o", exr],
+                           check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        return float(re.findall(r" in ([0-9.]+) s, ", r.stderr)[-1]), mse(load(exr), "rust-v")
+
+    rows = []
+    for k in range(a.speed):
+        seed = 1000 + k  # not one of the references' seeds
+        m = {}
+        for integ in ("volpath", "volpathmis"):
+            xml = os.path.join(a.out, f"cornell-medium-{integ}.xml")
+            write_xml(xml, True, integ)
+            base = os.path.join(a.out, f"speed-{integ}-s{seed}")
+            subprocess.run([sys.executable, os.path.join(HARNESS, "render.py"), xml, "--variant", a.variant,
+                            "--spp", "64", "--seed", str(seed), "--res", str(RES), "--max-depth", "8", "--warmup",
+                            "--out", base], check=True, stdout=subprocess.DEVNULL, stderr=sys.stderr)
+            m[integ] = (json.load(open(base + ".json"))["render_s"], mse(load(base + ".exr"), "mitsuba"))
+        best = min(m, key=lambda i: m[i][0] * m[i][1])  # the lower time x error
+        target = m[best][1]
+        tot_t, tot_n = 0.0, 0
+        n = 16
+        t, e = rustv(n, seed)
+        tot_t, tot_n = tot_t + t, tot_n + n
+        n = max(1, math.ceil(n * e / target))
+        t, e = rustv(n, seed)
+        tot_t, tot_n = tot_t + t, tot_n + n
+        if e > target:
+            guess = n
+            while e > target and n < 4 * guess:
+                n = max(n + 1, math.ceil(n * 1.05))
+                t, e = rustv(n, seed)
+                tot_t, tot_n = tot_t + t, tot_n + n
+        else:
+            while n > 1:
+                p = max(1, math.floor(n / 1.05)) if n > 20 else n - 1
+                t2, e2 = rustv(p, seed)
+                tot_t, tot_n = tot_t + t2, tot_n + p
+                if e2 > target:
+                    break
+                n, e = p, e2
+        rt = n * tot_t / tot_n
+        print(f"# speed round {k + 1}: volpath {m['volpath']}, volpathmis {m['volpathmis']}, rust-v {n} spp "
+              f"{rt:.2f} s MSE {e:.4g}", file=sys.stderr, flush=True)
+        rows.append((seed, m, best, n, rt, e))
+    lines = ["**Time to equal error, medium scene** (128x128; Mitsuba `llvm_ad_spectral` at 64 spp against "
+             f"the mean of its {a.seeds} x {a.mitsuba_spp}-spp images; rust-v `{a.rustv_integrator}` against the "
+             f"mean of its {a.seeds} x {a.rustv_spp}-spp images)", "",
+             "| round (seed) | volpath: time (s), MSE | volpathmis: time (s), MSE | rust-v spp | rust-v time (s) | "
+             "its MSE | rust-v / better Mitsuba |", "|---|---|---|---|---|---|---|"]
+    ratios = []
+    for seed, m, best, n, rt, e in rows:
+        ratios.append(rt / m[best][0])
+        lines.append(f"| {seed} | {m['volpath'][0]:.2f}, {m['volpath'][1]:.4g} | {m['volpathmis'][0]:.2f}, "
+                     f"{m['volpathmis'][1]:.4g} | {n} | {rt:.2f} | {e:.4g} | {ratios[-1]:.2f} ({best}) |")
+    ratios.sort()
+    lines += ["", f"Median time ratio rust-v / Mitsuba: **{ratios[len(ratios) // 2]:.2f}x**.", ""]
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default=os.path.join(HERE, "target", "release", "rust-v"))
@@ -300,6 +377,8 @@ def main():
     ap.add_argument("--integrator", default="volpath")
     ap.add_argument("--out", default="/tmp/peer-media")
     ap.add_argument("--compare-only", action="store_true")
+    ap.add_argument("--speed", type=int, default=0, metavar="ROUNDS",
+                    help="then time to equal error on the medium scene, ROUNDS rounds (references: the images above)")
     a = ap.parse_args()
     check_ron()
     os.makedirs(a.out, exist_ok=True)
@@ -313,6 +392,8 @@ def main():
         print(compare(scene, results[scene], a), flush=True)
     if "medium" in results and "plain" in results:
         print(effect(results, a), flush=True)
+    if a.speed and "medium" in results:
+        print(speed(a, results["medium"]), flush=True)
     print(f"loadavg after {open('/proc/loadavg').read().split()[:3]}")
 
 

@@ -2,7 +2,7 @@
 # rust-v against Mitsuba 3 on a chromatic homogeneous medium in the Cornell box (issue 30):
 # runs scripts/peer_media.py (which see) with the Mitsuba harness's venv python.
 #
-#   scripts/peer_media.sh [--bin BINARY] [--seeds 4] [--mitsuba-spp 1024] [--rustv-spp 1024] ...
+#   scripts/peer_media.sh [--bin BINARY] [--seeds 8] [--mitsuba-spp 1024] [--rustv-spp 2048] [--speed 5] ...
 #
 # Needs the harness ../shared/peers/mitsuba and its venv (bash ../shared/peers/mitsuba/setup.sh)
 # and a release build (cargo build --release).
