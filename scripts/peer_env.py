@@ -212,6 +212,39 @@ def white_floor(binary, out):
     for name, path in [("rust-v, 256 spp", r), ("Mitsuba llvm_ad_spectral, 1024 spp", m)]:
         v = load(path).reshape(-1, 3).mean(axis=0)
         print(f"| {name} | " + " | ".join(f"{x:.4f} ({100 * (x / e - 1):+.1f}%)" for x, e in zip(v, expected)) + " |")
+    # The sun seen directly (30° field of view towards it, +x and 35° up): its core and the texels
+    # its bilinear filter blends with the sky, along the middle row.
+    sun_dir = "0.819152, 0.573576, 0"
+    ron = os.path.join(out, "sun.ron")
+    open(ron, "w").write(f"""(
+    camera: (eye: (0, 0, 0), look_at: ({sun_dir}), up: (0, 1, 0), fov_deg: 30),
+    render: (width: 32, height: 32, spp: 64, seed: 0, max_bounces: 1),
+    materials: {{ "black": Lambertian(reflectance: Constant(0)) }},
+    objects: [ (shape: Sphere(center: (-50, -50, -50), radius: 0.01), material: "black") ],
+    environment: Image(path: "{exr}"),
+)
+""")
+    xml = os.path.join(out, "sun.xml")
+    open(xml, "w").write(f"""<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+    <sensor type="perspective">
+        <string name="fov_axis" value="y"/><float name="fov" value="30"/>
+        <transform name="to_world"><lookat origin="0, 0, 0" target="{sun_dir}" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="256"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/>
+            <string name="pixel_format" value="rgb"/><rfilter type="box"/></film>
+    </sensor>
+    <emitter type="envmap"><string name="filename" value="{exr}"/></emitter>
+</scene>
+""")
+    r = os.path.join(out, "sun-rustv.exr")
+    subprocess.run([binary, "render", ron, "-o", r], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, m = mitsuba(xml, "llvm_ad_spectral", 256, 3, out)
+    ri, mi_ = load(r), load(m)
+    print("\nThe sun seen directly, 30° wide, the middle row (linear sRGB):\n")
+    print("| pixel | rust-v | Mitsuba |\n|---|---|---|")
+    for x in range(6, 27, 2):
+        print(f"| {x} | " + " | ".join("(" + ", ".join(f"{c:.2f}" for c in img[16, x]) + ")" for img in (ri, mi_)) + " |")
 
 
 def log(*a):
