@@ -30,9 +30,9 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
-use crate::color::{Spectrum, Uplift};
+use crate::color::{Spectrum, Uplift, fit_rows};
 use crate::error::Result;
-use crate::io::image::{Pixels, decode_image};
+use crate::io::image::decode_image;
 use crate::scene::check::Check;
 use crate::scene::desc::{SpectrumDesc, Wrap};
 
@@ -103,7 +103,7 @@ impl ImageTexture {
         if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
         }
-        let texels = fit_rows(width, rgb, scale);
+        let texels = fit_rows(width, rgb, scale, Uplift::reflectance, Uplift::coefficients);
         Ok(ImageTexture { width, height, texels, uv_scale, uv_offset, wrap })
     }
 
@@ -147,31 +147,6 @@ impl ImageTexture {
     }
 }
 
-/// Every texel's reflectance uplift, `scale` folded in: rows in parallel,
-/// each fit along a row starting from the previous texel's coefficients, a
-/// repeated colour reusing them (see [`Uplift::reflectance`]).
-fn fit_rows(width: usize, rgb: &[[f32; 3]], scale: f32) -> Vec<Uplift> {
-    use rayon::prelude::*;
-    let rows: Vec<Vec<Uplift>> = rgb
-        .par_chunks(width)
-        .map(|row| {
-            let mut out = Vec::with_capacity(width);
-            let mut prev: Option<([f32; 3], Uplift)> = None;
-            for &p in row {
-                let c = p.map(|v| v * scale);
-                let texel = match prev {
-                    Some((pc, t)) if pc == c => t,
-                    _ => Uplift::reflectance(c, prev.map(|(_, t)| t.coefficients())),
-                };
-                prev = Some((c, texel));
-                out.push(texel);
-            }
-            out
-        })
-        .collect();
-    rows.concat()
-}
-
 /// The reflectance at field `field`: a [`Texture`] for `Image` and
 /// `Checkerboard`, else `None` (the caller builds the constant spectrum).
 pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
@@ -194,12 +169,7 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<
             let (uv_scale, uv_offset) = (finite2("uv_scale", *uv_scale)?, finite2("uv_offset", *uv_offset)?);
             let (resolved, bytes) = check.read_input(&path_field, path)?;
             let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
-            let rgb: Vec<[f32; 3]> = match pixels {
-                Pixels::Linear(p) => p.into_iter().map(|c| c.map(|v| v as f32)).collect(),
-                Pixels::Code16(p) => {
-                    p.into_iter().map(|c| c.map(|v| crate::color::srgb_eotf(v as f32 / 65535.0))).collect()
-                }
-            };
+            let rgb = pixels.linear_rgb();
             let image = ImageTexture::new(w as usize, h as usize, &rgb, scale, uv_scale, uv_offset, *wrap)
                 .map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
             Texture::Image(Arc::new(image))

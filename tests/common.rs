@@ -33,12 +33,23 @@ pub fn render_str_bins(ron: &str, overrides: &SettingsPatch) -> Film {
     render_film(ron, overrides, true)
 }
 
+/// Renders the scene file at `path` (its textures, maps and grids beside it) with
+/// overrides; returns the film. Asserts that no sample was NaN or infinite.
+pub fn render_file(path: &Path, overrides: &SettingsPatch) -> Film {
+    let scene = rust_v::scene::load_scene(path, overrides).expect("test scene loads");
+    render_scene(&scene, false)
+}
+
 fn render_film(ron: &str, overrides: &SettingsPatch, bins: bool) -> Film {
     let scene = load_scene_str(ron, Path::new("test.ron"), overrides).expect("test scene loads");
+    render_scene(&scene, bins)
+}
+
+fn render_scene(scene: &rust_v::scene::Scene, bins: bool) -> Film {
     let s = &scene.settings;
     let mut film = if bins { Film::new_spectral(s.width, s.height, 0) } else { Film::new(s.width, s.height) };
     let stop = AtomicBool::new(false);
-    let stats = render(&scene, &mut film, 0..s.spp, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
+    let stats = render(scene, &mut film, 0..s.spp, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
     assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
     film
 }

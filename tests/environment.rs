@@ -7,7 +7,7 @@
 
 use rust_v::settings::SettingsPatch;
 
-use crate::common::{mean_and_stderr, render_str, temp_dir};
+use crate::common::{mean_and_stderr, render_file, render_str, temp_dir};
 
 fn furnace(rho: f32, integrator: &str) -> String {
     format!(
@@ -90,19 +90,10 @@ fn a_constant_image_map_renders_like_uniform_rgb() {
     };
     let path = dir.join("scene.ron");
     std::fs::write(&path, scene(r#"Image(path: "map.png")"#)).unwrap();
-    let map_scene = rust_v::scene::load_scene(&path, &SettingsPatch::default()).expect("map scene loads");
+    let film = render_file(&path, &SettingsPatch::default());
     let uniform = render_str(
         &scene(&format!("Uniform(Rgb({}, {}, {}))", decoded[0], decoded[1], decoded[2])),
         &SettingsPatch::default(),
-    );
-    let mut film = rust_v::film::Film::new(16, 16);
-    let stop = std::sync::atomic::AtomicBool::new(false);
-    rust_v::render::render(
-        &map_scene,
-        &mut film,
-        0..64,
-        rust_v::render::Limits { stop: &stop, time_budget: None },
-        &mut |_, _| {},
     );
     for c in 0..3 {
         let (a, sa) = mean_and_stderr(&film, c);
@@ -157,18 +148,7 @@ fn path_bdpt_and_light_tracing_agree_under_an_image_map() {
     let render = |integrator: &str, spp: u32| {
         let path = dir.join(format!("{integrator}.ron"));
         std::fs::write(&path, scene(integrator, spp)).unwrap();
-        let scene = rust_v::scene::load_scene(&path, &SettingsPatch::default()).expect("scene loads");
-        let mut film = rust_v::film::Film::new(32, 32);
-        let stop = std::sync::atomic::AtomicBool::new(false);
-        let stats = rust_v::render::render(
-            &scene,
-            &mut film,
-            0..spp,
-            rust_v::render::Limits { stop: &stop, time_budget: None },
-            &mut |_, _| {},
-        );
-        assert_eq!(stats.invalid_samples, 0, "{integrator}: NaN samples");
-        crate::common::block_means(&film, 4)
+        crate::common::block_means(&render_file(&path, &SettingsPatch::default()), 4)
     };
     let reference = render("path", 128);
     let mean_ref = reference.iter().sum::<f64>() / reference.len() as f64;

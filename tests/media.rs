@@ -161,19 +161,7 @@ fn grid_media_match_homogeneous_and_keep_energy() {
     let render = |medium: &str, seed: u64, floor: bool| {
         let path = dir.join(format!("s{seed}.ron"));
         std::fs::write(&path, scene(medium, floor)).unwrap();
-        let s = rust_v::scene::load_scene(&path, &SettingsPatch { seed: Some(seed), ..Default::default() })
-            .expect("scene loads");
-        let mut film = rust_v::film::Film::new(16, 16);
-        let stop = std::sync::atomic::AtomicBool::new(false);
-        let stats = rust_v::render::render(
-            &s,
-            &mut film,
-            0..64,
-            rust_v::render::Limits { stop: &stop, time_budget: None },
-            &mut |_, _| {},
-        );
-        assert_eq!(stats.invalid_samples, 0);
-        film
+        crate::common::render_file(&path, &SettingsPatch { seed: Some(seed), ..Default::default() })
     };
     let coeffs = "sigma_a: Table([(380, 0.1), (730, 0.6)]), sigma_s: Rayleigh(1.2), phase: HenyeyGreenstein(g: 0.4)";
     let homogeneous = render(&format!("Homogeneous({coeffs})"), 1, true);

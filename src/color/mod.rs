@@ -25,5 +25,5 @@ pub use space::ColorSpace;
 pub use spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Sampled, Spectrum, bin_lambda_nm};
 pub use tonemap::Tonemap;
 pub use uplift::{
-    Uplift, emission_spectrum, emission_uplift, reflectance_to_linear_srgb, rgb_emission, rgb_reflectance,
+    Uplift, emission_spectrum, emission_uplift, fit_rows, reflectance_to_linear_srgb, rgb_emission, rgb_reflectance,
 };

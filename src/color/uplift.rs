@@ -247,6 +247,40 @@ impl Uplift {
     }
 }
 
+/// Uplifts an image of rows of `width` linear sRGB texels, each times `scale`,
+/// with `fit` (a colour and, where there is one, the previous texel's
+/// coefficients to start from: see [`Uplift::reflectance`]). Rows are fitted
+/// in parallel; along a row a texel of the same colour as the previous reuses
+/// its result, so an image of one colour gives every texel exactly what
+/// `fit` gives that colour alone. `coefficients` gives a result's coefficients.
+pub fn fit_rows<T: Copy + Send>(
+    width: usize,
+    rgb: &[[f32; 3]],
+    scale: f32,
+    fit: impl Fn([f32; 3], Option<[f64; 3]>) -> T + Sync,
+    coefficients: impl Fn(&T) -> [f64; 3] + Sync,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    let rows: Vec<Vec<T>> = rgb
+        .par_chunks(width)
+        .map(|row| {
+            let mut out = Vec::with_capacity(width);
+            let mut prev: Option<([f32; 3], T)> = None;
+            for &p in row {
+                let c = p.map(|v| v * scale);
+                let texel = match prev {
+                    Some((pc, t)) if pc == c => t,
+                    _ => fit(c, prev.map(|(_, t)| coefficients(&t))),
+                };
+                prev = Some((c, texel));
+                out.push(texel);
+            }
+            out
+        })
+        .collect();
+    rows.concat()
+}
+
 /// The squared colour error of coefficients `c` against `target`.
 fn colour_error2(c: [f64; 3], target: [f64; 3]) -> f64 {
     let rgb = reflectance_to_linear_srgb(&eval(c));

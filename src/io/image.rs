@@ -116,6 +116,19 @@ pub enum Pixels {
     Code16(Vec<[u16; 3]>),
 }
 
+impl Pixels {
+    /// Linear sRGB values: EXR values as they are, PNG codes through the sRGB
+    /// transfer function (IEC 61966-2-1; 8-bit codes were widened exactly).
+    pub fn linear_rgb(self) -> Vec<[f32; 3]> {
+        match self {
+            Pixels::Linear(p) => p.into_iter().map(|c| c.map(|v| v as f32)).collect(),
+            Pixels::Code16(p) => {
+                p.into_iter().map(|c| c.map(|v| crate::color::srgb_eotf(v as f32 / 65535.0))).collect()
+            }
+        }
+    }
+}
+
 /// Reads a PNG (8 or 16 bits per channel) or an EXR (linear sRGB floats):
 /// width, height and pixels.
 pub fn read_image(path: &Path) -> Result<(u32, u32, Pixels)> {

@@ -85,17 +85,7 @@ fn a_sun_in_a_map_lights_a_floor_with_every_method() {
     let path = dir.join("scene.ron");
     std::fs::write(&path, scene).unwrap();
     for m in METHODS {
-        let s = rust_v::scene::load_scene(&path, &method(m, 64, 6)).expect("scene loads");
-        let mut film = rust_v::film::Film::new(12, 12);
-        let stop = std::sync::atomic::AtomicBool::new(false);
-        let stats = rust_v::render::render(
-            &s,
-            &mut film,
-            0..64,
-            rust_v::render::Limits { stop: &stop, time_budget: None },
-            &mut |_, _| {},
-        );
-        assert_eq!(stats.invalid_samples, 0, "{m}: NaN samples");
+        let film = crate::common::render_file(&path, &method(m, 64, 6));
         let (mean, se) = mean_se(&y(&film));
         eprintln!("a sun in a map over a floor, {m}: Y = {mean:.5} ± {se:.5}, want {want:.5}");
         assert!((mean - want).abs() < 5.0 * se + 0.01 * want, "{m}: Y = {mean} ± {se}, want {want}");

@@ -1,0 +1,320 @@
+//! The environment: radiance arriving from infinitely far away in every
+//! direction a ray escapes to (pbrt-v4 §12.5, Mitsuba 3's `envmap` and
+//! `constant` emitters).
+//!
+//! ```ron
+//! environment: Uniform(Constant(1)),
+//! environment: Image(path: "sky.exr", scale: 1, rotate_deg: (0, 90, 0)),
+//! ```
+//!
+//! # Orientation of an `Image` map
+//! The map is equirectangular (latitude-longitude) with +y up, in the same
+//! convention as Mitsuba 3's `envmap`, so one file lights both renderers
+//! alike: the top row looks up (+y), the bottom row down (−y), the middle row
+//! at the horizon; along a row, the left edge (u = 0) looks towards −z, a
+//! quarter across (u = 0.25) towards +x, the centre (u = 0.5) towards +z,
+//! three quarters (u = 0.75) towards −x. For a direction `m` in the map's frame,
+//! `u = atan2(m.x, −m.z) / 2π` (wrapped into [0, 1)) and `v = acos(m.y) / π`.
+//! `rotate_deg: (x, y, z)` turns the map about X, then Y, then Z, as an
+//! object's `transform` turns a shape (`docs/scene-format.md` has a picture).
+//!
+//! # Radiance and sampling
+//! Each texel's linear sRGB colour becomes an emission spectrum as `Rgb(...)`
+//! does for an emitter (`crate::color::rgb_emission`: the Jakob-Hanika sigmoid
+//! times D65, fitted per texel at load, kept as three coefficients and a
+//! scale). A direction's radiance is the bilinear blend of the four nearest
+//! texels' spectra (wrapping in u, clamped at the poles).
+//!
+//! Directions are importance-sampled from a piecewise-constant density over
+//! the texel grid ([`Piecewise2D`]) whose cell weights are the texel
+//! neighbourhood's mean radiance (the 3x3 block around it: bilinear filtering
+//! spreads a texel's radiance into its neighbours' cells, so every cell where
+//! the radiance is not zero has a non-zero density: no bias) times `sin θ`
+//! (the solid angle of a row). A point `(u, v)` of density `p(u, v)` is a
+//! direction of density `p(u, v) / (2π² sin θ)` per solid angle. `Uniform`
+//! samples the sphere uniformly (`1/4π`).
+//!
+//! Light subpaths (BDPT, light tracing) start from the environment as pbrt-v4
+//! does: a direction `ω` sampled as above, then a point uniformly on the disk
+//! of the scene's bounding radius `R` that faces `ω`, upstream of the scene:
+//! the ray travels along `−ω` with densities `p(ω)` (direction) and `1/(πR²)`
+//! (position). The emitted power, for choosing among lights, is
+//! `πR² ∫ L(ω) dω` (the flux through that disk).
+
+use std::f32::consts::{FRAC_PI_2, PI};
+
+use glam::{Mat3, Vec2, Vec3};
+
+use super::{EmissionSample, LightSample, emit::parallel_ray};
+use crate::color::{Spectrum, d65, emission_spectrum};
+use crate::error::Result;
+use crate::geometry::Transform;
+use crate::io::image::decode_image;
+use crate::sampler::piecewise::Piecewise2D;
+use crate::sampler::warp::uniform_sphere;
+use crate::scene::check::Check;
+use crate::scene::desc::EnvironmentDesc;
+
+mod map;
+mod sky;
+#[cfg(test)]
+mod tests;
+
+use map::{CACHED_TEXELS, EnvMap, fit_texels, from_uv, to_uv};
+use sky::SkyEnv;
+
+/// The most texels an environment map may have (a 8192 x 4096 map): each
+/// costs 28 bytes and a fit at load.
+pub const MAX_MAP_TEXELS: usize = 1 << 25;
+
+/// Radiance from every direction at infinity.
+#[derive(Clone, Debug)]
+pub struct EnvironmentLight {
+    source: Source,
+    /// World directions into the map's frame (`rotate_deg` inverted), and back.
+    to_map: Mat3,
+    from_map: Mat3,
+    /// The per-bin maximum radiance over directions (for warnings about
+    /// values beyond the film's range; not a direction's radiance).
+    pub peak: Spectrum,
+    /// `∫ mean_λ L(ω) dω` over the sphere.
+    integral: f32,
+    /// The centre and radius of a sphere around the scene (set by the scene).
+    pub scene_center: Vec3,
+    /// See `scene_center`.
+    pub scene_radius: f32,
+}
+
+/// Where the radiance comes from.
+#[derive(Clone, Debug)]
+enum Source {
+    /// The same spectrum from every direction.
+    Uniform(Spectrum),
+    /// An equirectangular map.
+    Map(Box<EnvMap>),
+    /// The Hosek-Wilkie sky and its sun.
+    Sky(Box<SkyEnv>),
+}
+
+impl EnvironmentLight {
+    /// Radiance `spectrum` from every direction.
+    pub fn uniform(spectrum: Spectrum) -> EnvironmentLight {
+        EnvironmentLight {
+            integral: 4.0 * PI * spectrum.average(),
+            peak: spectrum,
+            source: Source::Uniform(spectrum),
+            to_map: Mat3::IDENTITY,
+            from_map: Mat3::IDENTITY,
+            scene_center: Vec3::ZERO,
+            scene_radius: 1.0,
+        }
+    }
+
+    /// A map of `width` x `height` linear sRGB texels (row 0 at the top),
+    /// scaled by `scale`, turned by `rotation` (world from map). Errors (as
+    /// plain messages: the caller names the field) for an empty or too large
+    /// map, a negative or non-finite texel, or a map that is black everywhere.
+    pub fn map(width: usize, height: usize, rgb: &[[f32; 3]], scale: f32, rotation: Mat3) -> Result<Self, String> {
+        if width == 0 || height == 0 || rgb.len() != width * height {
+            return Err(format!("expected a non-empty image, found {width}x{height}"));
+        }
+        if width * height > MAX_MAP_TEXELS {
+            return Err(format!(
+                "{width}x{height} is more than the {MAX_MAP_TEXELS} texels an environment map may have"
+            ));
+        }
+        if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !(c.is_finite() && *c >= 0.0))) {
+            let p = rgb[k];
+            return Err(format!(
+                "texel ({}, {}) is ({}, {}, {}): expected finite, non-negative values",
+                k % width,
+                k / width,
+                p[0],
+                p[1],
+                p[2]
+            ));
+        }
+        let d65 = d65();
+        let texels = fit_texels(width, rgb, scale);
+        // Each texel's mean radiance, and the peak.
+        let mean: Vec<f32> = texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &d65).average()).collect();
+        let mut peak = Spectrum::ZERO;
+        let mut integral = 0.0f64;
+        for j in 0..height {
+            let (t0, t1) = (PI * j as f32 / height as f32, PI * (j + 1) as f32 / height as f32);
+            let solid = (2.0 * PI / width as f32) * (t0.cos() - t1.cos());
+            for i in 0..width {
+                let k = j * width + i;
+                integral += (mean[k] * solid) as f64;
+                if mean[k] > 0.0 {
+                    let s = emission_spectrum(&texels[k].uplift, texels[k].scale, &d65);
+                    peak = Spectrum::from_fn(|b| peak[b].max(s[b]));
+                }
+            }
+        }
+        if !(integral > 0.0 && integral.is_finite()) {
+            return Err("the map is black everywhere (or its total is not finite): it emits nothing".into());
+        }
+        // Sampling weights: the 3x3 neighbourhood's mean, times sin θ of the row.
+        let mut weights = vec![0.0f32; width * height];
+        for j in 0..height {
+            let sin = (PI * (j as f32 + 0.5) / height as f32).sin();
+            for i in 0..width {
+                let mut sum = 0.0f32;
+                for dj in -1i64..=1 {
+                    let jj = (j as i64 + dj).clamp(0, height as i64 - 1) as usize;
+                    for di in -1i64..=1 {
+                        let ii = (i as i64 + di).rem_euclid(width as i64) as usize;
+                        sum += mean[jj * width + ii];
+                    }
+                }
+                weights[j * width + i] = sum / 9.0 * sin;
+            }
+        }
+        let dist = Piecewise2D::new(&weights, width, height)
+            .ok_or_else(|| "the map's sampling density is zero or not finite".to_string())?;
+        let spectra = if texels.len() <= CACHED_TEXELS {
+            texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &d65)).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(EnvironmentLight {
+            source: Source::Map(Box::new(EnvMap { width, height, texels, spectra, dist, d65 })),
+            to_map: rotation.transpose(),
+            from_map: rotation,
+            peak,
+            integral: integral as f32,
+            scene_center: Vec3::ZERO,
+            scene_radius: 1.0,
+        })
+    }
+    /// The radiance arriving from world direction `wi` (pointing away from the scene).
+    #[inline(never)]
+    pub fn radiance(&self, wi: Vec3) -> Spectrum {
+        match &self.source {
+            Source::Uniform(s) => *s,
+            Source::Map(m) => m.radiance(to_uv(self.to_map * wi)),
+            Source::Sky(sky) => sky.radiance(wi),
+        }
+    }
+
+    /// Total power up to the spectrum's shape: `πR² ∫ mean L dω`.
+    pub fn power(&self) -> f32 {
+        PI * self.scene_radius * self.scene_radius * self.integral
+    }
+
+    /// A direction towards the environment from `p`, by its density; the
+    /// returned point lies beyond the scene's bounds along it.
+    #[inline(never)]
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let (wi, pdf) = self.sample_direction(u)?;
+        let point = p + wi * (2.0 * self.scene_radius);
+        Some(LightSample { wi, point, n: -wi, pdf, scale: 1.0, is_delta: false })
+    }
+
+    /// The density per solid angle of [`Self::sample_li`] choosing world direction `wi`.
+    #[inline(never)]
+    pub fn pdf_li(&self, wi: Vec3) -> f32 {
+        match &self.source {
+            Source::Uniform(_) => 1.0 / (4.0 * PI),
+            Source::Map(m) => {
+                let mm = self.to_map * wi;
+                // sin θ from x and z: accurate near the poles, where 1 − y² is not.
+                let sin = (mm.x * mm.x + mm.z * mm.z).sqrt();
+                if sin <= 0.0 {
+                    return 0.0;
+                }
+                m.dist.pdf(to_uv(mm)) / (2.0 * PI * PI * sin)
+            }
+            Source::Sky(sky) => sky.pdf(wi),
+        }
+    }
+
+    /// A world direction towards the environment and its density per solid angle.
+    #[inline]
+    fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        match &self.source {
+            Source::Uniform(_) => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
+            Source::Map(m) => {
+                let (uv, pdf_uv) = m.dist.sample(u);
+                let (mm, sin) = from_uv(uv);
+                let pdf = pdf_uv / (2.0 * PI * PI * sin);
+                (pdf.is_finite() && pdf > 0.0).then(|| ((self.from_map * mm).normalize(), pdf))
+            }
+            Source::Sky(sky) => sky.sample(u),
+        }
+    }
+
+    /// A ray leaving the environment into the scene (see the module doc).
+    #[inline]
+    pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let (wi, pdf_dir) = self.sample_direction(u_dir)?;
+        let r = self.scene_radius;
+        let mut e = parallel_ray(self.scene_center + wi * r, -wi, r, u_pos)?;
+        e.pdf_dir = pdf_dir;
+        Some(e)
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`] for a ray travelling along `dir`.
+    #[inline]
+    pub(super) fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
+        (1.0 / (PI * self.scene_radius * self.scene_radius), self.pdf_li(-dir))
+    }
+}
+
+impl EnvironmentLight {
+    /// The environment of the scene description at field `environment`.
+    pub(crate) fn from_desc(check: &Check, d: &EnvironmentDesc) -> Result<EnvironmentLight> {
+        const FIELD: &str = "environment";
+        match d {
+            EnvironmentDesc::Uniform(s) => {
+                let s = check.spectrum(&format!("{FIELD}.Uniform"), s)?;
+                if s.average() <= 0.0 {
+                    return Err(check.err(FIELD, "a Uniform environment must emit something (found black)"));
+                }
+                Ok(EnvironmentLight::uniform(s))
+            }
+            EnvironmentDesc::Image { path, scale, rotate_deg } => {
+                let field = format!("{FIELD}.path");
+                let scale = check.positive(&format!("{FIELD}.scale"), *scale)?;
+                let rotation = Transform {
+                    rotate_deg: check.vec(&format!("{FIELD}.rotate_deg"), *rotate_deg)?,
+                    ..Transform::default()
+                }
+                .linear();
+                let (resolved, bytes) = check.read_input(&field, path)?;
+                let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&field, e.to_string()))?;
+                let rgb = pixels.linear_rgb();
+                EnvironmentLight::map(w as usize, h as usize, &rgb, scale, rotation)
+                    .map_err(|m| check.err(&field, format!("{path}: {m}")))
+            }
+            EnvironmentDesc::Sky { sun_elevation_deg, sun_azimuth_deg, turbidity, ground_albedo, scale } => {
+                let scale = check.positive(&format!("{FIELD}.scale"), *scale)?;
+                if !sun_azimuth_deg.is_finite() {
+                    return Err(check.err(
+                        format!("{FIELD}.sun_azimuth_deg"),
+                        format!("expected a finite angle in degrees, found {sun_azimuth_deg}"),
+                    ));
+                }
+                if !(0.0..=90.0).contains(sun_elevation_deg) {
+                    return Err(check.err(
+                        format!("{FIELD}.sun_elevation_deg"),
+                        format!("expected degrees in [0, 90] (the sky model's range), found {sun_elevation_deg}"),
+                    ));
+                }
+                let elevation = (sun_elevation_deg.to_radians()).min(FRAC_PI_2);
+                EnvironmentLight::sky(*turbidity, *ground_albedo, elevation, sun_azimuth_deg.to_radians(), scale)
+                    .map_err(|m| {
+                        // The model's message starts with the parameter's name.
+                        let name = m.split_whitespace().next().unwrap_or("");
+                        let field = match name {
+                            "turbidity" => "turbidity",
+                            "ground_albedo" => "ground_albedo",
+                            _ => "sun_elevation_deg",
+                        };
+                        check.err(format!("{FIELD}.{field}"), m)
+                    })
+            }
+        }
+    }
+}
