@@ -36,15 +36,19 @@ pub const INTEGRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
 
 /// The 1 nm table as rows `(λ, [x̄, ȳ, z̄])`. The table is compiled in and checked by the tests,
 /// so a malformed row is a build defect, not user input: it is skipped (and a test fails).
-pub(crate) fn cmf_1nm() -> Vec<(f64, [f64; 3])> {
-    CMF_1NM_CSV
-        .lines()
-        .skip(1)
-        .filter_map(|line| {
-            let v: Vec<f64> = line.split(',').filter_map(|c| c.trim().parse().ok()).collect();
-            (v.len() == 4).then(|| (v[0], [v[1], v[2], v[3]]))
-        })
-        .collect()
+/// Parsed once (0.85 M instructions): the colour weights and the default sensor's curves share it.
+pub(crate) fn cmf_1nm() -> &'static [(f64, [f64; 3])] {
+    static T: LazyLock<Vec<(f64, [f64; 3])>> = LazyLock::new(|| {
+        CMF_1NM_CSV
+            .lines()
+            .skip(1)
+            .filter_map(|line| {
+                let v: Vec<f64> = line.split(',').filter_map(|c| c.trim().parse().ok()).collect();
+                (v.len() == 4).then(|| (v[0], [v[1], v[2], v[3]]))
+            })
+            .collect()
+    });
+    &T
 }
 
 /// The interpolation tent of bin `b` at `lambda_nm`: 1 at the bin centre, falling linearly to 0
@@ -86,7 +90,7 @@ pub fn tent_weights(table: &[(f64, [f64; 3])]) -> [[f64; 3]; N_BINS] {
 
 /// The exact colour weights in f64 (see the module doc), for fitting and tests.
 pub fn color_weights_f64() -> &'static [[f64; 3]; N_BINS] {
-    static W: LazyLock<[[f64; 3]; N_BINS]> = LazyLock::new(|| tent_weights(&cmf_1nm()));
+    static W: LazyLock<[[f64; 3]; N_BINS]> = LazyLock::new(|| tent_weights(cmf_1nm()));
     &W
 }
 
@@ -109,7 +113,7 @@ pub fn cmf_at(lambda_nm: f32) -> [f32; 3] {
 /// The 1 nm CMF table over 360-830 nm divided by `∫ ȳ dλ`, as [`cmf_at`] interpolates it (the
 /// default sensor's continuous curves, [`crate::color::Sensor`]).
 pub(crate) fn cmf_table() -> &'static [[f32; 3]] {
-    static TABLE: LazyLock<Vec<[f32; 3]>> = LazyLock::new(|| normalised_curves(&cmf_1nm()));
+    static TABLE: LazyLock<Vec<[f32; 3]>> = LazyLock::new(|| normalised_curves(cmf_1nm()));
     &TABLE
 }
 

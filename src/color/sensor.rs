@@ -409,7 +409,7 @@ mod tests {
     #[test]
     fn cmfs_as_a_sensor_fit_exactly() {
         let mut text = String::from("wavelength_nm,r,g,b\n");
-        for (nm, c) in crate::color::cie::cmf_1nm() {
+        for &(nm, c) in crate::color::cie::cmf_1nm() {
             text += &format!("{nm},{},{},{}\n", c[0], c[1], c[2]);
         }
         let s = sensor(&text).unwrap();
