@@ -273,7 +273,8 @@ impl Sensor {
                 let m = f.to_srgb.map(|r| format!("[{:.6}, {:.6}, {:.6}]", r[0], r[1], r[2])).join(", ");
                 format!(
                     "sensor {}: camera RGB -> linear sRGB [{m}], fitted on the ColorChecker under D65 (white exact): RMS residual {:.6}",
-                    self.name, f.residual
+                    crate::error::show_path(Path::new(&self.name)),
+                    f.residual
                 )
             }
         }
