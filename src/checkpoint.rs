@@ -71,7 +71,7 @@ pub const FORMAT_VERSION: u32 = 5;
 pub const SPECTRAL_FORMAT_VERSION: u32 = 6;
 
 /// The format version of a colour film made with a sensor file: version 5 whose header also
-/// holds the sensor ([`SensorRecord`]).
+/// holds the sensor (its name and the file's text).
 pub const SENSOR_FORMAT_VERSION: u32 = 7;
 
 /// The versions written before the `sampler` setting (colour, spectral): read, never written.
