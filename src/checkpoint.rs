@@ -25,6 +25,12 @@
 //! same layout, its payload followed (inside the same lz4 block) by `width × height × 36`
 //! fixed-point per-bin sums.
 //!
+//! A film made with a sensor file (`--sensor`, [`crate::color::Sensor`]) is written as version 7
+//! ([`SENSOR_FORMAT_VERSION`]): version 5 whose header also holds the sensor, its name and the
+//! file's whole text, after the inputs' hashes. A resume projects on exactly that sensor (the
+//! file need not exist any more), and merging films of different sensors is refused. Renders with
+//! the default sensor write versions 5 and 6, byte for byte as before.
+//!
 //! Versions 1 (colour) and 2 (spectral), written before the `sampler` setting existed,
 //! are still read: their header's settings end before `sampler`, and they resume and
 //! merge as `sampler: independent`, the sampler that wrote them (the independent
@@ -63,6 +69,10 @@ pub const FORMAT_VERSION: u32 = 5;
 /// also holds 36 fixed-point per-bin sums per pixel after the XYZ sums. Colour-only renders
 /// write version 5, so their checkpoints stay as small as before.
 pub const SPECTRAL_FORMAT_VERSION: u32 = 6;
+
+/// The format version of a colour film made with a sensor file: version 5 whose header also
+/// holds the sensor (its name and the file's text).
+pub const SENSOR_FORMAT_VERSION: u32 = 7;
 
 /// The versions written before the `sampler` setting (colour, spectral): read, never written.
 pub const FORMAT_1_VERSIONS: [u32; 2] = [1, 2];
@@ -164,6 +174,21 @@ struct HeaderWithInputs {
     inputs: InputHashes,
 }
 
+/// The sensor of a version 7 checkpoint: its name (the file as given) and the file's text.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct SensorRecord {
+    name: String,
+    csv: String,
+}
+
+/// The header of version 7: version 5's, then the sensor.
+#[derive(Serialize, Deserialize)]
+struct HeaderWithSensor {
+    header: Header,
+    inputs: InputHashes,
+    sensor: SensorRecord,
+}
+
 #[derive(Serialize)]
 struct PayloadRef<'a> {
     width: u32,
@@ -244,15 +269,25 @@ impl Checkpoint {
         let config = bincode::config::standard();
         let encode_error =
             |e: bincode::error::EncodeError| Error::checkpoint(&self.output, format!("cannot encode: {e}"));
-        let header = match &self.inputs {
-            Some(inputs) => bincode::serde::encode_to_vec(HeaderWithInputs { header, inputs: inputs.clone() }, config),
-            None => bincode::serde::encode_to_vec(&header, config),
+        let sensor = film.sensor().csv().map(|csv| SensorRecord { name: film.sensor().name().into(), csv: csv.into() });
+        let header = match (&self.inputs, &sensor) {
+            (inputs, Some(sensor)) => bincode::serde::encode_to_vec(
+                HeaderWithSensor { header, inputs: inputs.clone().unwrap_or_default(), sensor: sensor.clone() },
+                config,
+            ),
+            (Some(inputs), None) => {
+                bincode::serde::encode_to_vec(HeaderWithInputs { header, inputs: inputs.clone() }, config)
+            }
+            (None, None) => bincode::serde::encode_to_vec(&header, config),
         }
         .map_err(encode_error)?;
         let (width, height, sums) = (film.width(), film.height(), film.sums());
         let [colour_version, spectral_version] =
             if self.inputs.is_some() { [FORMAT_VERSION, SPECTRAL_FORMAT_VERSION] } else { FORMAT_3_VERSIONS };
         let (version, raw) = match film.spectral_sums() {
+            None if sensor.is_some() => {
+                (SENSOR_FORMAT_VERSION, bincode::serde::encode_to_vec(PayloadRef { width, height, sums }, config))
+            }
             None => (colour_version, bincode::serde::encode_to_vec(PayloadRef { width, height, sums }, config)),
             Some(spectral) => (
                 spectral_version,
@@ -287,9 +322,9 @@ impl Checkpoint {
             return Err(bad(format!("truncated: {} bytes, the fixed header alone is {PREFIX_LEN}", bytes.len())));
         }
         let version = u32_at(bytes, 8);
-        if !(1..=SPECTRAL_FORMAT_VERSION).contains(&version) {
+        if !(1..=SENSOR_FORMAT_VERSION).contains(&version) {
             return Err(bad(format!(
-                "format version {version}; this rust-v ({}) reads versions 1 to {SPECTRAL_FORMAT_VERSION}",
+                "format version {version}; this rust-v ({}) reads versions 1 to {SENSOR_FORMAT_VERSION}",
                 env!("CARGO_PKG_VERSION")
             )));
         }
@@ -322,7 +357,14 @@ impl Checkpoint {
         let header_config = config.with_limit::<{ 1 << 20 }>();
         let corrupt_header = |e: bincode::error::DecodeError| bad(format!("corrupt header: {e}"));
         let mut inputs = None;
-        let (h, used): (Header, usize) = if format_1 {
+        let mut sensor = None;
+        let (h, used): (Header, usize) = if version == SENSOR_FORMAT_VERSION {
+            let (h, used): (HeaderWithSensor, usize) =
+                bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?;
+            inputs = Some(h.inputs);
+            sensor = Some(h.sensor);
+            (h.header, used)
+        } else if format_1 {
             let (h, used): (Header<SettingsFormat1>, usize) =
                 bincode::serde::decode_from_slice(header_bytes, header_config).map_err(corrupt_header)?;
             let Header { crate_version, scene_path, content_hash, settings, first_pass, end_pass, target_end, output } =
@@ -382,6 +424,11 @@ impl Checkpoint {
         if let Some(s) = spectral_sums {
             film = film.with_spectral_sums(s).map_err(|e| bad(format!("corrupt payload: {e}")))?;
         }
+        if let Some(SensorRecord { name, csv }) = sensor {
+            let s = crate::color::Sensor::from_csv(&name, &csv, Path::new(&name))
+                .map_err(|e| bad(format!("corrupt header: its sensor: {e}")))?;
+            film.set_sensor(std::sync::Arc::new(s)).map_err(|e| bad(format!("corrupt header: {e}")))?;
+        }
         Ok(Checkpoint {
             crate_version: h.crate_version,
             scene_path: h.scene_path,
@@ -427,7 +474,19 @@ impl Checkpoint {
             ));
         }
         let diffs = self.settings.differences(&other.settings);
-        (!diffs.is_empty()).then(|| format!("different settings: {}", diffs.join(", ")))
+        if !diffs.is_empty() {
+            return Some(format!("different settings: {}", diffs.join(", ")));
+        }
+        let (mine, theirs) = (self.film.sensor(), other.film.sensor());
+        (mine != theirs).then(|| {
+            let same_name = mine.name() == theirs.name();
+            format!(
+                "different sensors: {} vs {}{}",
+                theirs.name(),
+                mine.name(),
+                if same_name { " (the same name, different curves)" } else { "" }
+            )
+        })
     }
 }
 
@@ -565,9 +624,9 @@ mod tests {
         assert_eq!(Checkpoint::decode(&bytes, Path::new("o.ckpt")).unwrap().settings, other.settings);
         assert!(c.incompatibility(&other).is_some_and(|why| why.contains("sampler")));
         let mut bytes = c.encode().unwrap();
-        bytes[8..12].copy_from_slice(&7u32.to_le_bytes());
+        bytes[8..12].copy_from_slice(&8u32.to_le_bytes());
         let e = Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap_err().to_string();
-        assert!(e.contains("format version 7") && e.contains("reads versions 1 to 6"), "{e}");
+        assert!(e.contains("format version 8") && e.contains("reads versions 1 to 7"), "{e}");
     }
 
     /// Versions 5 and 6 keep each input's hash; a checkpoint without them (read from an
@@ -582,6 +641,25 @@ mod tests {
         let bytes = old.encode().unwrap();
         assert_eq!(u32_at(&bytes, 8), 3);
         assert_eq!(Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap(), old);
+    }
+
+    /// A film of a sensor file is version 7, holding the sensor's text: it reads back with the
+    /// same sensor (its curves and matrix), and does not merge with a default-sensor part.
+    #[test]
+    fn the_sensor_is_recorded() {
+        let c = sample();
+        let text = "wavelength_nm,r,g,b\n400,0,0.2,1\n500,0.1,1,0.2\n600,1,0.3,0\n700,0.5,0,0\n";
+        let sensor = crate::color::Sensor::from_csv("s.csv", text, Path::new("s.csv")).unwrap();
+        let mut with = c.clone();
+        with.film.set_sensor(std::sync::Arc::new(sensor)).unwrap();
+        let bytes = with.encode().unwrap();
+        assert_eq!(u32_at(&bytes, 8), SENSOR_FORMAT_VERSION);
+        let back = Checkpoint::decode(&bytes, Path::new("x.ckpt")).unwrap();
+        assert_eq!(back, with);
+        assert_eq!(back.film.sensor().csv(), Some(text));
+        let why = c.incompatibility(&with).unwrap();
+        assert!(why.contains("different sensors: s.csv vs cie1931"), "{why}");
+        assert!(merge(vec![("a.ckpt".into(), with), ("b.ckpt".into(), c)]).is_err());
     }
 
     /// Exactly the inputs whose hash differs are named, the scene file by its path.

@@ -131,7 +131,8 @@ pub struct Limits<'a> {
 ///
 /// # Panics
 /// When `film` holds passes and `passes` does not continue them: callers
-/// check this (e.g. [`crate::checkpoint`] resume does).
+/// check this (e.g. [`crate::checkpoint`] resume does); when the scene's sensor is not the
+/// film's ([`Film::set_sensor`]: the film's sums are the scene's sensor's channels).
 pub fn render(
     scene: &Scene,
     film: &mut Film,
@@ -168,6 +169,12 @@ impl Run<'_, '_> {
             film.start_at(passes.start);
         }
         assert_eq!(film.pass_range().end, passes.start, "render must continue the film's passes");
+        assert!(
+            std::sync::Arc::ptr_eq(&scene.sensor, film.sensor()) || scene.sensor == *film.sensor(),
+            "the scene's sensor ({}) must be the film's ({})",
+            scene.sensor.name(),
+            film.sensor().name()
+        );
         let tiles = tiles(film.width(), film.height(), TILE_SIZE);
         let pixels = film.width() as usize * film.height() as usize;
         let batch = passes_per_batch(tiles.len(), pixels, std::mem::size_of::<O>());

@@ -23,6 +23,7 @@ mod output;
 mod pbrt;
 mod sampler;
 mod scenes;
+mod sensor;
 mod spectra;
 mod spectral;
 mod stability;

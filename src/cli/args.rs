@@ -121,9 +121,15 @@ pub struct RenderArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Colour space of EXR output: srgb (linear, default), rec2020, acescg (Bradford-adapted
-    /// from D65) or xyz. PNG output is always sRGB.
+    /// from D65), xyz, or camera (a --sensor file's raw camera RGB). PNG output is always sRGB.
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
+    /// The camera's sensor: cie1931 (the CIE 1931 colour matching functions, default: the film
+    /// holds XYZ) or a CSV of three response curves `wavelength_nm,r,g,b` (the film holds camera
+    /// RGB, converted to sRGB by a matrix fitted on the ColorChecker under D65; docs/sensors.md).
+    /// Stored in the checkpoint: resume and merge use the checkpoint's.
+    #[arg(long, value_name = "cie1931|FILE.csv", default_value = "cie1931")]
+    pub sensor: PathBuf,
     #[command(flatten)]
     pub picture: PictureArgs,
     /// With an .exr output: also write the 36 spectral bins (380-730 nm) as channels in the
@@ -171,7 +177,7 @@ pub struct ResumeArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Colour space of EXR output: srgb (linear, default; not stored in the checkpoint: give it again), rec2020, acescg (Bradford-adapted
-    /// from D65) or xyz. PNG output is always sRGB.
+    /// from D65), xyz, or camera (the checkpoint's sensor's raw camera RGB). PNG output is always sRGB.
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
     #[command(flatten)]
@@ -196,7 +202,7 @@ pub struct MergeArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Colour space of EXR output: srgb (linear, default), rec2020, acescg (Bradford-adapted
-    /// from D65) or xyz. PNG output is always sRGB.
+    /// from D65), xyz, or camera (the checkpoints' sensor's raw camera RGB). PNG output is always sRGB.
     #[arg(long, value_name = "SPACE", default_value = "srgb", value_parser = parse_color_space)]
     pub color_space: ColorSpace,
     #[command(flatten)]

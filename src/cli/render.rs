@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use rust_v::checkpoint::{Checkpoint, default_checkpoint_path, merge};
-use rust_v::color::{ColorSpace, Tonemap};
+use rust_v::color::{ColorSpace, Sensor, Tonemap};
 use rust_v::error::{Error, Result, show_path};
 use rust_v::film::{Film, MAX_SAMPLE};
 use rust_v::io::{NAME_MAX, check_aliasing, check_output, is_snapshot_name, parent_dir};
@@ -37,10 +37,19 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     if args.spectral && !rust_v::io::image::is_exr(&output) {
         return Err(Error::Settings(format!("--spectral needs an .exr output, found {}", show_path(&output))));
     }
+    let sensor = Sensor::from_arg(&args.sensor)?;
+    check_sensor_space(&sensor, args.color_space)?;
+    if args.spectral && !sensor.is_cie1931() {
+        return Err(Error::Settings(format!(
+            "--spectral writes the 36 bins with their CIE XYZ; it cannot take --sensor {}",
+            show_path(&args.sensor)
+        )));
+    }
     let load_start = Instant::now();
     // Loading (meshes are read and built in parallel) uses the threads asked for too.
-    let (scene, warnings) = thread_pool(args.run.threads)?
+    let (mut scene, warnings) = thread_pool(args.run.threads)?
         .install(|| load_scene_with_warnings(&args.scene, &args.settings.overrides(), args.strict))?;
+    scene.sensor = sensor.clone();
     for w in &warnings {
         warn(format_args!("{w}"));
     }
@@ -80,10 +89,15 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
             s.seed,
         ));
         say(format_args!("{}", rust_v::integrator::describe(&scene)));
+        if !sensor.is_cie1931() {
+            say(format_args!("{}", sensor.describe()));
+        }
     }
     let passes = args.passes.clone().unwrap_or(0..if open_ended { u32::MAX } else { s.spp });
     let checkpoint_path = args.checkpoint.checkpoint.clone().unwrap_or_else(|| default_checkpoint_path(&output));
-    check_files(&args.scene, &scene, &[], &output, &checkpoint_path, args.spectral)?;
+    let sensor_input = [("sensor", args.sensor.as_path())];
+    let extra: &[(&str, &Path)] = if sensor.is_cie1931() { &[] } else { &sensor_input };
+    check_files(&args.scene, &scene, extra, &output, &checkpoint_path, args.spectral)?;
     let scene_path = std::path::absolute(&args.scene).map_err(|e| Error::io(&args.scene, e))?;
     let mut checkpoint = Checkpoint {
         crate_version: env!("CARGO_PKG_VERSION").into(),
@@ -99,6 +113,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         },
         inputs: Some(scene.input_hashes.clone()),
     };
+    checkpoint.film.set_sensor(sensor)?;
     checkpoint.film.set_color_space(args.color_space);
     checkpoint.film.set_picture(args.picture.exposure, args.picture.tonemap);
     let plan = SessionPlan::new(checkpoint_path, &args.checkpoint, output, &args.run, args.time);
@@ -129,12 +144,15 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
     check_output_extension(&output)?;
     check_color_space(&output, args.color_space)?;
     check_tonemap(&output, args.picture.tonemap)?;
+    check_sensor_space(ckpt.film.sensor(), args.color_space)?;
     ckpt.film.set_color_space(args.color_space);
     ckpt.film.set_picture(args.picture.exposure, args.picture.tonemap);
-    let scene = thread_pool(args.run.threads)?
+    let mut scene = thread_pool(args.run.threads)?
         .install(|| load_scene_with_warnings(&ckpt.scene_path, &ckpt.settings.patch(), false))
         .map_err(|e| Error::checkpoint(path, format!("cannot load its scene {}: {e}", show_path(&ckpt.scene_path))))?
         .0;
+    // The checkpoint's sensor, whatever the file it came from holds now.
+    scene.sensor = ckpt.film.sensor().clone();
     if scene.content_hash != ckpt.content_hash {
         let changed = match &ckpt.inputs {
             Some(old) => {
@@ -179,6 +197,9 @@ pub fn resume_command(args: ResumeArgs) -> Result<()> {
             done.end,
             end.max(done.end)
         ));
+        if !scene.sensor.is_cie1931() {
+            say(format_args!("{}", scene.sensor.describe()));
+        }
     }
     ckpt.target_end = end.max(done.end);
     ckpt.output = std::path::absolute(&output).map_err(|e| Error::io(&output, e))?;
@@ -252,6 +273,7 @@ pub fn merge_command(args: MergeArgs) -> Result<()> {
     if !is_ckpt {
         check_color_space(&args.output, args.color_space)?;
         check_tonemap(&args.output, args.picture.tonemap)?;
+        check_sensor_space(merged.film.sensor(), args.color_space)?;
         merged.film.set_color_space(args.color_space);
         merged.film.set_picture(args.picture.exposure, args.picture.tonemap);
     }
@@ -293,6 +315,16 @@ fn check_color_space(output: &Path, space: ColorSpace) -> Result<()> {
             space.name(),
             show_path(output)
         )));
+    }
+    Ok(())
+}
+
+/// `--color-space camera` is a sensor file's raw camera RGB: the default sensor has none.
+fn check_sensor_space(sensor: &Sensor, space: ColorSpace) -> Result<()> {
+    if space == ColorSpace::Camera && sensor.is_cie1931() {
+        return Err(Error::Settings(
+            "--color-space camera writes a sensor file's raw camera RGB; the sensor is cie1931, whose film holds CIE XYZ (use --color-space xyz, or give --sensor FILE.csv)".into(),
+        ));
     }
     Ok(())
 }

@@ -36,15 +36,19 @@ pub const INTEGRAL_RANGE_NM: (f64, f64) = (360.0, 830.0);
 
 /// The 1 nm table as rows `(λ, [x̄, ȳ, z̄])`. The table is compiled in and checked by the tests,
 /// so a malformed row is a build defect, not user input: it is skipped (and a test fails).
-fn cmf_1nm() -> Vec<(f64, [f64; 3])> {
-    CMF_1NM_CSV
-        .lines()
-        .skip(1)
-        .filter_map(|line| {
-            let v: Vec<f64> = line.split(',').filter_map(|c| c.trim().parse().ok()).collect();
-            (v.len() == 4).then(|| (v[0], [v[1], v[2], v[3]]))
-        })
-        .collect()
+/// Parsed once (0.85 M instructions): the colour weights and the default sensor's curves share it.
+pub(crate) fn cmf_1nm() -> &'static [(f64, [f64; 3])] {
+    static T: LazyLock<Vec<(f64, [f64; 3])>> = LazyLock::new(|| {
+        CMF_1NM_CSV
+            .lines()
+            .skip(1)
+            .filter_map(|line| {
+                let v: Vec<f64> = line.split(',').filter_map(|c| c.trim().parse().ok()).collect();
+                (v.len() == 4).then(|| (v[0], [v[1], v[2], v[3]]))
+            })
+            .collect()
+    });
+    &T
 }
 
 /// The interpolation tent of bin `b` at `lambda_nm`: 1 at the bin centre, falling linearly to 0
@@ -86,7 +90,7 @@ pub fn tent_weights(table: &[(f64, [f64; 3])]) -> [[f64; 3]; N_BINS] {
 
 /// The exact colour weights in f64 (see the module doc), for fitting and tests.
 pub fn color_weights_f64() -> &'static [[f64; 3]; N_BINS] {
-    static W: LazyLock<[[f64; 3]; N_BINS]> = LazyLock::new(|| tent_weights(&cmf_1nm()));
+    static W: LazyLock<[[f64; 3]; N_BINS]> = LazyLock::new(|| tent_weights(cmf_1nm()));
     &W
 }
 
@@ -103,20 +107,36 @@ pub fn color_weights() -> &'static [[f32; 3]; N_BINS] {
 /// weights' normalisation, so that `∫ cmf_at(λ) · L(λ) dλ` is the XYZ of `L` and, for a spectrum
 /// given by 36 bins, equals `Σ_b W_b · L_b`. Per nm; zero outside 360-830 nm (and for NaN).
 pub fn cmf_at(lambda_nm: f32) -> [f32; 3] {
-    static TABLE: LazyLock<Vec<[f32; 3]>> = LazyLock::new(|| {
-        let t = cmf_1nm();
-        // ∫ ȳ of the linearly interpolated table: the trapezoidal rule is exact.
-        let y: f64 = t.windows(2).map(|p| 0.5 * (p[0].1[1] + p[1].1[1]) * (p[1].0 - p[0].0)).sum();
-        t.iter().map(|r| r.1.map(|v| (v / y) as f32)).collect()
-    });
+    curve_at(cmf_table(), lambda_nm)
+}
+
+/// The 1 nm CMF table over 360-830 nm divided by `∫ ȳ dλ`, as [`cmf_at`] interpolates it (the
+/// default sensor's continuous curves, [`crate::color::Sensor`]).
+pub(crate) fn cmf_table() -> &'static [[f32; 3]] {
+    static TABLE: LazyLock<Vec<[f32; 3]>> = LazyLock::new(|| normalised_curves(cmf_1nm()));
+    &TABLE
+}
+
+/// Rows `(λ, [a, b, c])` at 1 nm from 360 nm on, divided by the integral of the second column
+/// (`∫ ȳ`, or a sensor's green) of their linear interpolation, as f32.
+pub(crate) fn normalised_curves(t: &[(f64, [f64; 3])]) -> Vec<[f32; 3]> {
+    // ∫ of the linearly interpolated table: the trapezoidal rule is exact.
+    let y: f64 = t.windows(2).map(|p| 0.5 * (p[0].1[1] + p[1].1[1]) * (p[1].0 - p[0].0)).sum();
+    t.iter().map(|r| r.1.map(|v| (v / y) as f32)).collect()
+}
+
+/// A 1 nm table from 360 nm on ([`cmf_table`], a sensor's) linearly interpolated at
+/// `lambda_nm`; zero outside the table (and for NaN).
+#[inline]
+pub(crate) fn curve_at(table: &[[f32; 3]], lambda_nm: f32) -> [f32; 3] {
     let x = lambda_nm - INTEGRAL_RANGE_NM.0 as f32;
-    let last = TABLE.len().saturating_sub(1);
+    let last = table.len().saturating_sub(1);
     if !(x >= 0.0 && x <= last as f32) {
         return [0.0; 3];
     }
     let i = (x as usize).min(last.saturating_sub(1));
     let f = x - i as f32;
-    let (a, b) = (TABLE[i], TABLE[(i + 1).min(last)]);
+    let (a, b) = (table[i], table[(i + 1).min(last)]);
     std::array::from_fn(|k| a[k] + (b[k] - a[k]) * f)
 }
 

@@ -11,6 +11,7 @@
 mod cie;
 mod named;
 mod rgb;
+mod sensor;
 mod space;
 mod spectrum;
 mod tonemap;
@@ -21,6 +22,7 @@ pub use named::{COLOR_CHECKER_NAMES, blackbody, color_checker, d65, equal_energy
 pub use rgb::{
     LINEAR_SRGB_TO_XYZ, LinearSrgb, Srgb, XYZ_TO_LINEAR_SRGB, Xyz, srgb_eotf, srgb_oetf, xyz_to_linear_srgb_f64,
 };
+pub use sensor::{CIE1931, Matrix3, Sensor, color_checker_pairs};
 pub use space::ColorSpace;
 pub use spectrum::{LAMBDA_MIN_NM, LAMBDA_STEP_NM, N_BINS, Sampled, Spectrum, bin_lambda_nm};
 pub use tonemap::Tonemap;

@@ -27,6 +27,10 @@ pub enum ColorSpace {
     AcesCg,
     /// CIE 1931 XYZ itself (channels X, Y, Z), D65-referred.
     Xyz,
+    /// A sensor's raw camera RGB (`--sensor FILE`), before its colour correction: the film's
+    /// sums as they are, no conversion from XYZ (`crate::film::Film::write`), and no
+    /// `chromaticities` attribute (camera RGB has no primaries).
+    Camera,
 }
 
 /// CIE xy chromaticities of red, green, blue and white.
@@ -44,9 +48,10 @@ const BRADFORD: [[f64; 3]; 3] = [[0.8951, 0.2664, -0.1614], [-0.7502, 1.7135, 0.
 
 impl ColorSpace {
     /// Every space, in the order of [`ColorSpace::NAMES`].
-    pub const ALL: [ColorSpace; 4] = [ColorSpace::Srgb, ColorSpace::Rec2020, ColorSpace::AcesCg, ColorSpace::Xyz];
+    pub const ALL: [ColorSpace; 5] =
+        [ColorSpace::Srgb, ColorSpace::Rec2020, ColorSpace::AcesCg, ColorSpace::Xyz, ColorSpace::Camera];
     /// The names on the command line.
-    pub const NAMES: [&'static str; 4] = ["srgb", "rec2020", "acescg", "xyz"];
+    pub const NAMES: [&'static str; 5] = ["srgb", "rec2020", "acescg", "xyz", "camera"];
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
@@ -59,13 +64,14 @@ impl ColorSpace {
     }
 
     /// The xy chromaticities of the primaries and white (what an EXR's `chromaticities`
-    /// attribute records); XYZ is the OpenEXR convention (1, 0), (0, 1), (0, 0), (1/3, 1/3).
+    /// attribute records); XYZ is the OpenEXR convention (1, 0), (0, 1), (0, 0), (1/3, 1/3), and so
+    /// is camera RGB, for which no attribute is written.
     pub fn chromaticities(self) -> Primaries {
         match self {
             ColorSpace::Srgb => [[0.64, 0.33], [0.30, 0.60], [0.15, 0.06], D65_XY],
             ColorSpace::Rec2020 => REC2020,
             ColorSpace::AcesCg => AP1,
-            ColorSpace::Xyz => [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0], [1.0 / 3.0, 1.0 / 3.0]],
+            ColorSpace::Xyz | ColorSpace::Camera => [[1.0, 0.0], [0.0, 1.0], [0.0, 0.0], [1.0 / 3.0, 1.0 / 3.0]],
         }
     }
 
@@ -74,11 +80,11 @@ impl ColorSpace {
         if self == ColorSpace::Xyz { ["X", "Y", "Z"] } else { ["R", "G", "B"] }
     }
 
-    /// D65-referred XYZ to this space.
+    /// D65-referred XYZ to this space (camera RGB is not made from XYZ: unchanged).
     pub fn from_xyz(self, xyz: [f64; 3]) -> [f64; 3] {
         match self {
             ColorSpace::Srgb => xyz_to_linear_srgb_f64(xyz),
-            ColorSpace::Xyz => xyz,
+            ColorSpace::Xyz | ColorSpace::Camera => xyz,
             ColorSpace::Rec2020 | ColorSpace::AcesCg => mul(&self.matrix(), xyz),
         }
     }

@@ -37,11 +37,20 @@
 //! - EXR (when the name ends in `.exr`): linear sRGB as 32-bit floats,
 //!   unclamped, for measurements; or Rec. 2020, ACEScg or XYZ when the film's
 //!   [`ColorSpace`] says so (`--color-space`).
+//!
+//! # Sensors
+//! With a sensor file (`--sensor`, [`Sensor`]) the three sums are the sensor's camera RGB,
+//! not XYZ: every output converts each pixel's mean with the sensor's colour-correction
+//! matrix first (to linear sRGB, through the XYZ of that sRGB for the other spaces), except
+//! `--color-space camera`, which writes the means as they are. A spectral film keeps the
+//! default sensor (its bins' colour is XYZ).
 
 use std::ops::Range;
 use std::path::Path;
 
-use crate::color::{ColorSpace, N_BINS, Spectrum, Tonemap, Xyz, bin_lambda_nm, xyz_to_linear_srgb_f64};
+use std::sync::Arc;
+
+use crate::color::{ColorSpace, N_BINS, Sensor, Spectrum, Tonemap, Xyz, bin_lambda_nm, xyz_to_linear_srgb_f64};
 use crate::error::{Error, Result};
 use crate::io::image::{is_exr, write_exr, write_exr_in, write_linear_srgb};
 
@@ -176,6 +185,8 @@ pub struct Film {
     /// Row-major per-bin radiance sums (fixed point like `sums`), when the film is spectral
     /// (`--spectral`): 36 more sums per pixel, whose colour integral is `sums`.
     spectral: Option<Vec<[i128; N_BINS]>>,
+    /// The sensor whose channels the sums hold ([`Sensor::cie1931`]: XYZ). Checkpoints store it.
+    sensor: Arc<Sensor>,
 }
 
 /// One camera sample as the film takes it: its XYZ and, for a spectral film, its per-bin
@@ -222,6 +233,7 @@ impl Film {
             exposure_ev: 0.0,
             tonemap: Tonemap::Clip,
             spectral: None,
+            sensor: Sensor::cie1931().clone(),
         }
     }
 
@@ -304,7 +316,27 @@ impl Film {
             exposure_ev: 0.0,
             tonemap: Tonemap::Clip,
             spectral: None,
+            sensor: Sensor::cie1931().clone(),
         })
+    }
+
+    /// Sets the sensor whose channels the film sums (before anything is added: a render
+    /// gives its scene's, a checkpoint the one it stored). A spectral film keeps the default:
+    /// its bins' colour is XYZ.
+    pub fn set_sensor(&mut self, sensor: Arc<Sensor>) -> Result<()> {
+        if self.spectral.is_some() && !sensor.is_cie1931() {
+            return Err(Error::Mismatch(format!(
+                "a spectral film (--spectral) holds XYZ with its 36 bins; it cannot take the sensor {}",
+                sensor.name()
+            )));
+        }
+        self.sensor = sensor;
+        Ok(())
+    }
+
+    /// The sensor whose channels the film sums.
+    pub fn sensor(&self) -> &Arc<Sensor> {
+        &self.sensor
     }
 
     /// Sets the colour space of EXR output (PNG output is always sRGB).
@@ -472,6 +504,13 @@ impl Film {
                 b.start, b.end, a.start, a.end
             )));
         }
+        if self.sensor != other.sensor {
+            return Err(Error::Mismatch(format!(
+                "a film of the sensor {} cannot be merged with one of the sensor {}",
+                other.sensor.name(),
+                self.sensor.name()
+            )));
+        }
         if self.spectral.is_some() != other.spectral.is_some() {
             return Err(Error::Mismatch("a spectral film (--spectral) cannot be merged with a colour-only one".into()));
         }
@@ -493,8 +532,21 @@ impl Film {
         Ok(())
     }
 
-    /// The mean XYZ of every pixel, row-major.
+    /// The mean XYZ of every pixel, row-major: the sums' means, or with a sensor file the XYZ of
+    /// their colour-corrected linear sRGB.
     pub fn mean_xyz(&self) -> Vec<[f64; 3]> {
+        let means = self.mean_sums();
+        match self.sensor.to_xyz() {
+            None => means,
+            Some(m) => means
+                .into_iter()
+                .map(|c| std::array::from_fn(|i| m[i][0] * c[0] + m[i][1] * c[1] + m[i][2] * c[2]))
+                .collect(),
+        }
+    }
+
+    /// The mean of each pixel's three sums, row-major: XYZ, or a sensor file's camera RGB.
+    pub fn mean_sums(&self) -> Vec<[f64; 3]> {
         let inv = if self.passes == 0 { 0.0 } else { 1.0 / self.passes as f64 };
         self.sums.iter().map(|s| s.map(|v| from_fixed(v) * inv)).collect()
     }
@@ -511,8 +563,11 @@ impl Film {
         let scale = self.exposure_ev.exp2();
         let expose = |v: f64| if self.exposure_ev == 0.0 { v } else { v * scale };
         if is_exr(path) && (self.color_space != ColorSpace::Srgb || self.spectral.is_some()) {
-            let pixels: Vec<[f64; 3]> =
-                self.mean_xyz().into_iter().map(|p| self.color_space.from_xyz(p).map(expose)).collect();
+            let pixels: Vec<[f64; 3]> = if self.color_space == ColorSpace::Camera {
+                self.mean_sums().into_iter().map(|p| p.map(expose)).collect()
+            } else {
+                self.mean_xyz().into_iter().map(|p| self.color_space.from_xyz(p).map(expose)).collect()
+            };
             let Some(spectral) = &self.spectral else {
                 return write_exr_in(path, self.width, self.height, &pixels, self.color_space);
             };

@@ -111,7 +111,7 @@ impl PathTracer {
             // The camera sees the environment (or black).
             return match scene.escaped(ray.dir) {
                 Some((_, le)) if scene.medium_in(scene.camera_volumes.current()).is_none() => {
-                    O::from_packet(lambdas, &lambdas.sample(&le))
+                    O::from_packet(&scene.sensor, lambdas, &lambdas.sample(&le))
                 }
                 _ => O::default(),
             };
@@ -303,7 +303,7 @@ impl PathTracer {
                 }
             }
         }
-        let mut out = O::from_packet(lambdas, &l);
+        let mut out = O::from_packet(&scene.sensor, lambdas, &l);
         out += split;
         out
     }

@@ -101,6 +101,6 @@ impl Whitted {
             bounces += 1;
             ray = Ray::spawn(hit.p, hit.n, wi);
         }
-        O::from_packet(lambdas, &l)
+        O::from_packet(&scene.sensor, lambdas, &l)
     }
 }

@@ -100,8 +100,10 @@ pub fn write_exr(
         AnyChannels::sort(channels.into()),
     );
     let mut image = exr::image::Image::from_layer(layer);
-    let xy = space.chromaticities().map(|[x, y]| Vec2(x as f32, y as f32));
-    image.attributes.chromaticities = Some(Chromaticities { red: xy[0], green: xy[1], blue: xy[2], white: xy[3] });
+    if space != ColorSpace::Camera {
+        let xy = space.chromaticities().map(|[x, y]| Vec2(x as f32, y as f32));
+        image.attributes.chromaticities = Some(Chromaticities { red: xy[0], green: xy[1], blue: xy[2], white: xy[3] });
+    }
     let mut bytes = Cursor::new(Vec::new());
     image.write().non_parallel().to_buffered(&mut bytes).map_err(|e| bad(e.to_string()))?;
     write_atomic(path, &bytes.into_inner())

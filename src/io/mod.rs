@@ -19,4 +19,6 @@ pub use atomic_file::{NAME_MAX, temp_path, write_atomic};
 pub use files::{check_aliasing, check_output, check_regular, is_snapshot_name, parent_dir, read_input};
 pub use hash::{Fnv1a, fnv1a};
 pub use mesh_file::{MeshData, parse_mesh, read_mesh_file};
-pub use spectrum_file::{SpectrumFileError, SpectrumRow, parse_spectrum_file, parse_spectrum_rows};
+pub use spectrum_file::{
+    SpectrumFileError, SpectrumRow, TableRow, parse_spectrum_file, parse_spectrum_rows, parse_table,
+};

@@ -59,7 +59,33 @@ pub fn parse_spectrum_file(text: &str) -> Result<Vec<(f32, f32)>, SpectrumFileEr
 
 /// Parses a two-column spectrum file into its rows in file order, each with its line.
 pub fn parse_spectrum_rows(text: &str) -> Result<Vec<SpectrumRow>, SpectrumFileError> {
-    let mut out: Vec<SpectrumRow> = Vec::new();
+    Ok(parse_table::<2>(text, "two numbers `nm,value`", "`nm,value`")?
+        .into_iter()
+        .map(|r| SpectrumRow { nm: r.values[0], value: r.values[1], line: r.line, value_col: r.cols[1] })
+        .collect())
+}
+
+/// One row of a table of `K` numbers per line (wavelength first), with where it stands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TableRow<const K: usize> {
+    /// The numbers, wavelength first.
+    pub values: [f32; K],
+    /// 1-based column (character) of each number.
+    pub cols: [usize; K],
+    /// 1-based line number.
+    pub line: usize,
+}
+
+/// Parses a table of `K` finite numbers a line, wavelengths (the first column) strictly
+/// increasing, in the format of a spectrum file (optional header, comments, any of the
+/// separators). `expected` says what a row is in errors (`"two numbers `nm,value`"`), `row`
+/// what an empty file lacks.
+pub fn parse_table<const K: usize>(
+    text: &str,
+    expected: &str,
+    row: &str,
+) -> Result<Vec<TableRow<K>>, SpectrumFileError> {
+    let mut out: Vec<TableRow<K>> = Vec::new();
     let mut seen_row = false;
     let mut fields: Vec<(&str, usize)> = Vec::new();
     for (n, raw) in text.lines().enumerate() {
@@ -87,28 +113,29 @@ pub fn parse_spectrum_rows(text: &str) -> Result<Vec<SpectrumRow>, SpectrumFileE
             continue;
         }
         seen_row = true;
-        if fields.len() != 2 {
-            return Err(err(
-                1,
-                format!("expected two numbers `nm,value`, found {} fields in {}", fields.len(), excerpt(raw)),
-            ));
+        if fields.len() != K {
+            return Err(err(1, format!("expected {expected}, found {} fields in {}", fields.len(), excerpt(raw))));
         }
-        let mut pair = [0.0f32; 2];
+        let mut values = [0.0f32; K];
+        let mut cols = [0usize; K];
         for (k, (text, col)) in fields.iter().enumerate() {
             match text.parse::<f32>() {
-                Ok(v) if v.is_finite() => pair[k] = v,
+                Ok(v) if v.is_finite() => (values[k], cols[k]) = (v, *col),
                 _ => return Err(err(*col, format!("expected a finite number, found {}", excerpt(text)))),
             }
         }
         if let Some(prev) = out.last()
-            && pair[0] <= prev.nm
+            && values[0] <= prev.values[0]
         {
-            return Err(err(fields[0].1, format!("wavelengths must increase: {} nm follows {} nm", pair[0], prev.nm)));
+            return Err(err(
+                fields[0].1,
+                format!("wavelengths must increase: {} nm follows {} nm", values[0], prev.values[0]),
+            ));
         }
-        out.push(SpectrumRow { nm: pair[0], value: pair[1], line: n + 1, value_col: fields[1].1 });
+        out.push(TableRow { values, cols, line: n + 1 });
     }
     if out.is_empty() {
-        return Err(SpectrumFileError { line: 1, col: 1, message: "expected at least one `nm,value` row".into() });
+        return Err(SpectrumFileError { line: 1, col: 1, message: format!("expected at least one {row} row") });
     }
     Ok(out)
 }

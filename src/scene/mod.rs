@@ -123,6 +123,9 @@ pub struct Scene {
     /// The hash of the scene file and of each file it reads, for naming the inputs
     /// that changed when a checkpoint is resumed.
     pub input_hashes: crate::checkpoint::InputHashes,
+    /// The camera's sensor: the curves every sample is projected on (`--sensor`; the CIE 1931
+    /// CMFs by default, and the film then holds XYZ). A render's film must have the same one.
+    pub sensor: std::sync::Arc<crate::color::Sensor>,
 }
 
 impl Scene {
@@ -228,6 +231,7 @@ impl Scene {
             content_hash,
             inputs: Vec::new(),
             input_hashes: Default::default(),
+            sensor: crate::color::Sensor::cie1931().clone(),
         }
     }
 

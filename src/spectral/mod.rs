@@ -90,7 +90,7 @@
 //! draws above ([`Contribution::CONTINUOUS`] is false for it), so that the 36
 //! channels weighted by `W_b` reproduce the colour film exactly.
 
-use crate::color::{self, N_BINS, Sampled, Spectrum, Xyz};
+use crate::color::{self, N_BINS, Sampled, Sensor, Spectrum, Xyz};
 
 mod continuous;
 
@@ -166,14 +166,21 @@ impl<const N: usize> Lambdas<N> {
         Lambdas { pos: [self.pos[i]], weight: self.weight, readout: self.readout }
     }
 
-    /// The colour of a packet of radiance values.
+    /// The colour of a packet of radiance values through the default sensor (CIE XYZ).
     pub fn xyz(&self, l: &Sampled<N>) -> Xyz {
+        self.project(Sensor::cie1931(), l)
+    }
+
+    /// The film's three channels for a packet of radiance values: its projection on the
+    /// sensor's curves ([`Sensor`]; XYZ for the default, `cie1931`). The curves are data, so
+    /// every sensor runs the same code.
+    pub fn project(&self, sensor: &Sensor, l: &Sampled<N>) -> Xyz {
         match self.readout {
             Readout::Spectral if N == N_BINS => {
                 // The identity packet (the full spectrum): bin i is value i, no
                 // index conversion (this runs once per camera sample).
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
-                for (v, w) in l.0.iter().zip(color::color_weights()) {
+                for (v, w) in l.0.iter().zip(sensor.weights()) {
                     x += v * w[0];
                     y += v * w[1];
                     z += v * w[2];
@@ -184,7 +191,7 @@ impl<const N: usize> Lambdas<N> {
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
                 for i in 0..N {
                     // Packets of sampled bins always sit on integer positions.
-                    let w = color::color_weights()[self.pos[i] as usize];
+                    let w = sensor.weights()[self.pos[i] as usize];
                     x += l.0[i] * w[0];
                     y += l.0[i] * w[1];
                     z += l.0[i] * w[2];
@@ -194,7 +201,7 @@ impl<const N: usize> Lambdas<N> {
             Readout::Continuous => {
                 let (mut x, mut y, mut z) = (0.0f32, 0.0f32, 0.0f32);
                 for i in 0..N {
-                    let c = color::cmf_at(self.lambda_nm(i));
+                    let c = sensor.at(self.lambda_nm(i));
                     x += l.0[i] * c[0];
                     y += l.0[i] * c[1];
                     z += l.0[i] * c[2];
@@ -209,7 +216,16 @@ impl<const N: usize> Lambdas<N> {
                     let channel = rgb_channel(self.lambda_nm(i));
                     rgb[channel] += l.0[i] * self.weight / 3.0;
                 }
-                color::LinearSrgb::new(rgb[0], rgb[1], rgb[2]).to_xyz()
+                match sensor.from_srgb() {
+                    None => color::LinearSrgb::new(rgb[0], rgb[1], rgb[2]).to_xyz(),
+                    // The RGB mode has no spectrum for a sensor to see: its linear sRGB goes to
+                    // the camera RGB that the colour correction takes back to it.
+                    Some(m) => {
+                        let c: [f32; 3] =
+                            std::array::from_fn(|k| m[k][0] * rgb[0] + m[k][1] * rgb[1] + m[k][2] * rgb[2]);
+                        Xyz::new(c[0], c[1], c[2])
+                    }
+                }
             }
         }
     }
@@ -260,16 +276,17 @@ pub(crate) trait Contribution: Copy + Default + core::ops::AddAssign + Send + Sy
     /// reproduce the colour exactly, so those paths stay at the bin centres.
     const CONTINUOUS: bool;
 
-    /// The contribution of a packet's radiance values.
-    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self;
+    /// The contribution of a packet's radiance values, projected on `sensor`'s curves where it
+    /// is a colour.
+    fn from_packet<const N: usize>(sensor: &Sensor, lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self;
 }
 
 impl Contribution for Xyz {
     const CONTINUOUS: bool = true;
 
     #[inline]
-    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
-        lambdas.xyz(l)
+    fn from_packet<const N: usize>(sensor: &Sensor, lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
+        lambdas.project(sensor, l)
     }
 }
 
@@ -277,7 +294,7 @@ impl Contribution for Spectrum {
     const CONTINUOUS: bool = false;
 
     #[inline]
-    fn from_packet<const N: usize>(lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
+    fn from_packet<const N: usize>(_: &Sensor, lambdas: &Lambdas<N>, l: &Sampled<N>) -> Self {
         lambdas.bins(l)
     }
 }

@@ -218,8 +218,10 @@ impl Estimator for Bdpt {
                     if t == 1 {
                         if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, sampler, &mut wl) {
                             let value = match c {
-                                Contrib::Full(c) => O::from_packet(&full, &c),
-                                Contrib::Single(v) => O::from_packet(&wl.single().lambdas, &Sampled([v])),
+                                Contrib::Full(c) => O::from_packet(&scene.sensor, &full, &c),
+                                Contrib::Single(v) => {
+                                    O::from_packet(&scene.sensor, &wl.single().lambdas, &Sampled([v]))
+                                }
                             };
                             splats.push(Splat { x: pixel.x as u32, y: pixel.y as u32, value });
                         }
@@ -231,9 +233,9 @@ impl Estimator for Bdpt {
                     }
                 }
             }
-            let mut out = O::from_packet(&full, &l);
+            let mut out = O::from_packet(&scene.sensor, &full, &l);
             if let Some(one) = wl.drawn {
-                out += O::from_packet(&one.lambdas, &Sampled([l_single]));
+                out += O::from_packet(&scene.sensor, &one.lambdas, &Sampled([l_single]));
             }
             out
         })
