@@ -92,6 +92,12 @@ struct Layout {
 
 /// Parses a whole (decompressed) PLY file.
 pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
+    parse_in(data, path, (data.len() >= PARALLEL_ASCII_BYTES).then_some(ASCII_CHUNK_LINES))
+}
+
+/// [`parse`], an ASCII body in chunks of `chunk_lines` lines on the thread
+/// pool (`None`: line by line).
+fn parse_in(data: &[u8], path: &Path, chunk_lines: Option<usize>) -> Result<PlyData> {
     let err = |msg: String| Error::mesh(path, msg);
     let (elements, format, body, header_lines) = parse_header(data, path)?;
     let vi = elements
@@ -138,7 +144,14 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
         uvs: uv.map(|_| Vec::with_capacity(nv)),
     };
     match format {
-        Format::Ascii => read_ascii(body, header_lines, &elements, vi, fi, &layout, &mut out, path)?,
+        Format::Ascii => {
+            let text =
+                std::str::from_utf8(body).map_err(|_| Error::mesh(path, "PLY body is not text (format says ascii)"))?;
+            let a = Ascii { text, header_lines, elements: &elements, vi, fi, layout: &layout, path };
+            if !chunk_lines.is_some_and(|n| a.read_chunked(&mut out, n)) {
+                a.read_serial(&mut out)?;
+            }
+        }
         _ => read_binary(body, format, &elements, vi, fi, &layout, &mut out, path)?,
     }
     Ok(out)
@@ -214,90 +227,181 @@ fn parse_header<'a>(data: &'a [u8], path: &Path) -> Result<Header<'a>> {
     Ok((elements, format, &data[pos..], line_no))
 }
 
-#[allow(clippy::too_many_arguments)]
-fn read_ascii(
-    body: &[u8],
+/// ASCII bodies of at least this many bytes are parsed in chunks on the thread pool.
+const PARALLEL_ASCII_BYTES: usize = 1 << 20;
+
+/// Non-blank lines per chunk of a parallel ASCII parse.
+const ASCII_CHUNK_LINES: usize = 16384;
+
+/// Where an ASCII body's data sits, shared by its readers.
+struct Ascii<'a> {
+    text: &'a str,
     header_lines: usize,
-    elements: &[Element],
+    elements: &'a [Element],
     vi: usize,
     fi: usize,
-    layout: &Layout,
-    out: &mut PlyData,
-    path: &Path,
-) -> Result<()> {
-    let text = std::str::from_utf8(body).map_err(|_| Error::mesh(path, "PLY body is not text (format says ascii)"))?;
-    let mut lines = text.lines().enumerate().map(|(i, l)| (i + header_lines + 1, l));
-    let mut last_line = header_lines;
-    let mut vals: Vec<f64> = Vec::new();
-    let mut poly: Vec<i64> = Vec::new();
-    for (ei, el) in elements.iter().enumerate() {
-        for instance in 0..el.count {
-            // Next non-blank line.
-            let (ln, line) = loop {
-                match lines.next() {
-                    Some((ln, l)) if l.trim().is_empty() => last_line = ln,
-                    Some(x) => break x,
-                    None => {
-                        return Err(Error::mesh(
-                            path,
-                            format!(
-                                "line {}: unexpected end of file: expected {} '{}' lines, found {instance}",
-                                last_line + 1,
-                                el.count,
-                                el.name
-                            ),
-                        ));
-                    }
-                }
-            };
-            last_line = ln;
-            let err = |msg: String| Error::mesh(path, format!("line {ln}: {msg}"));
-            let mut tok = line.split_ascii_whitespace();
-            let mut next_num = |what: &dyn Fn() -> String| -> Result<f64> {
-                let s = tok
-                    .next()
-                    .ok_or_else(|| err(format!("expected {} of element '{}', found end of line", what(), el.name)))?;
-                s.parse::<f64>().map_err(|_| err(format!("expected a number for {}, found '{s}'", what())))
-            };
-            vals.clear();
-            poly.clear();
-            for (pi, p) in el.props.iter().enumerate() {
-                match p.kind {
-                    Kind::Scalar(_) => vals.push(next_num(&|| format!("property '{}'", p.name))?),
-                    Kind::List(..) => {
-                        let n = next_num(&|| format!("the count of list '{}'", p.name))?;
-                        if !(n >= 0.0 && n.fract() == 0.0) {
-                            return Err(err(format!("bad list count {n} for '{}'", p.name)));
+    layout: &'a Layout,
+    path: &'a Path,
+}
+
+/// One part of a chunked ASCII parse: element `ei`'s lines in `range` of the
+/// text, the first of them line `first_line` of the file.
+struct Chunk {
+    ei: usize,
+    range: std::ops::Range<usize>,
+    first_line: usize,
+}
+
+impl Ascii<'_> {
+    /// The whole body, line by line: the reference reader, and the one whose
+    /// errors every reader reports.
+    fn read_serial(&self, out: &mut PlyData) -> Result<()> {
+        let mut lines = self.text.lines().enumerate().map(|(i, l)| (i + self.header_lines + 1, l));
+        let mut last_line = self.header_lines;
+        let (mut vals, mut poly) = (Vec::new(), Vec::new());
+        for (ei, el) in self.elements.iter().enumerate() {
+            for instance in 0..el.count {
+                // Next non-blank line.
+                let (ln, line) = loop {
+                    match lines.next() {
+                        Some((ln, l)) if l.trim().is_empty() => last_line = ln,
+                        Some(x) => break x,
+                        None => {
+                            return Err(Error::mesh(
+                                self.path,
+                                format!(
+                                    "line {}: unexpected end of file: expected {} '{}' lines, found {instance}",
+                                    last_line + 1,
+                                    el.count,
+                                    el.name
+                                ),
+                            ));
                         }
-                        let n = n as usize;
-                        for k in 0..n {
-                            let v = next_num(&|| format!("vertex index {} of {n} in list '{}'", k + 1, p.name))?;
-                            if ei == fi && pi == layout.face_list {
-                                if v.fract() != 0.0 {
-                                    return Err(err(format!("vertex index {v} is not an integer")));
-                                }
-                                poly.push(v as i64);
-                            }
-                        }
-                        vals.push(0.0);
                     }
-                }
-            }
-            if tok.next().is_some() {
-                return Err(err(format!(
-                    "more values than the {} properties of element '{}'",
-                    el.props.len(),
-                    el.name
-                )));
-            }
-            if ei == vi {
-                push_vertex(out, layout, |k| vals[k]);
-            } else if ei == fi {
-                push_polygon(out, &poly, elements[vi].count, err)?;
+                };
+                last_line = ln;
+                self.line(ei, line, ln, out, &mut vals, &mut poly)?;
             }
         }
+        Ok(())
     }
-    Ok(())
+
+    /// The body in chunks of `chunk_lines` non-blank lines, parsed at once on
+    /// the thread pool and joined in file order: the same data as
+    /// [`Ascii::read_serial`], bit for bit. A serial scan finds the chunks'
+    /// byte ranges (no per-line index is kept). False, with `out` untouched,
+    /// when any line is bad or the file ends early: the serial reader then
+    /// reports the first error as it always has.
+    fn read_chunked(&self, out: &mut PlyData, chunk_lines: usize) -> bool {
+        use rayon::prelude::*;
+        let mut chunks = Vec::new();
+        let mut pieces = self.text.split_inclusive('\n');
+        let (mut offset, mut ln) = (0usize, self.header_lines);
+        for (ei, el) in self.elements.iter().enumerate() {
+            let mut remaining = el.count;
+            while remaining > 0 {
+                let (start, first_line) = (offset, ln + 1);
+                let mut n = 0;
+                while n < remaining.min(chunk_lines) {
+                    let Some(piece) = pieces.next() else { return false };
+                    ln += 1;
+                    offset += piece.len();
+                    if !piece.trim().is_empty() {
+                        n += 1;
+                    }
+                }
+                chunks.push(Chunk { ei, range: start..offset, first_line });
+                remaining -= n;
+            }
+        }
+        let parts: Vec<Option<PlyData>> = chunks.par_iter().map(|c| self.chunk(c).ok()).collect();
+        if parts.iter().any(Option::is_none) {
+            return false;
+        }
+        for part in parts.into_iter().flatten() {
+            out.positions.extend_from_slice(&part.positions);
+            out.triangles.extend_from_slice(&part.triangles);
+            if let (Some(o), Some(p)) = (out.normals.as_mut(), &part.normals) {
+                o.extend_from_slice(p);
+            }
+            if let (Some(o), Some(p)) = (out.uvs.as_mut(), &part.uvs) {
+                o.extend_from_slice(p);
+            }
+        }
+        true
+    }
+
+    /// One chunk's vertices or triangles.
+    fn chunk(&self, c: &Chunk) -> Result<PlyData> {
+        let vertices = c.ei == self.vi;
+        let mut part = PlyData {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            normals: self.layout.normal.filter(|_| vertices).map(|_| Vec::new()),
+            uvs: self.layout.uv.filter(|_| vertices).map(|_| Vec::new()),
+        };
+        let (mut vals, mut poly) = (Vec::new(), Vec::new());
+        for (k, line) in self.text[c.range.clone()].lines().enumerate() {
+            if !line.trim().is_empty() {
+                self.line(c.ei, line, c.first_line + k, &mut part, &mut vals, &mut poly)?;
+            }
+        }
+        Ok(part)
+    }
+
+    /// Parses line `ln`, an instance of element `ei`, into `out`.
+    fn line(
+        &self,
+        ei: usize,
+        line: &str,
+        ln: usize,
+        out: &mut PlyData,
+        vals: &mut Vec<f64>,
+        poly: &mut Vec<i64>,
+    ) -> Result<()> {
+        let el = &self.elements[ei];
+        let err = |msg: String| Error::mesh(self.path, format!("line {ln}: {msg}"));
+        let mut tok = line.split_ascii_whitespace();
+        let mut next_num = |what: &dyn Fn() -> String| -> Result<f64> {
+            let s = tok
+                .next()
+                .ok_or_else(|| err(format!("expected {} of element '{}', found end of line", what(), el.name)))?;
+            s.parse::<f64>().map_err(|_| err(format!("expected a number for {}, found '{s}'", what())))
+        };
+        vals.clear();
+        poly.clear();
+        for (pi, p) in el.props.iter().enumerate() {
+            match p.kind {
+                Kind::Scalar(_) => vals.push(next_num(&|| format!("property '{}'", p.name))?),
+                Kind::List(..) => {
+                    let n = next_num(&|| format!("the count of list '{}'", p.name))?;
+                    if !(n >= 0.0 && n.fract() == 0.0) {
+                        return Err(err(format!("bad list count {n} for '{}'", p.name)));
+                    }
+                    let n = n as usize;
+                    for k in 0..n {
+                        let v = next_num(&|| format!("vertex index {} of {n} in list '{}'", k + 1, p.name))?;
+                        if ei == self.fi && pi == self.layout.face_list {
+                            if v.fract() != 0.0 {
+                                return Err(err(format!("vertex index {v} is not an integer")));
+                            }
+                            poly.push(v as i64);
+                        }
+                    }
+                    vals.push(0.0);
+                }
+            }
+        }
+        if tok.next().is_some() {
+            return Err(err(format!("more values than the {} properties of element '{}'", el.props.len(), el.name)));
+        }
+        if ei == self.vi {
+            push_vertex(out, self.layout, |k| vals[k]);
+        } else if ei == self.fi {
+            push_polygon(out, poly, self.elements[self.vi].count, err)?;
+        }
+        Ok(())
+    }
 }
 
 fn push_vertex(out: &mut PlyData, layout: &Layout, val: impl Fn(usize) -> f64) {
@@ -412,4 +516,69 @@ fn read_binary(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An ASCII PLY with normals, uvs, an element between vertices and faces,
+    /// quads, blank lines and CRLF line ends.
+    fn text(vertices: usize) -> String {
+        let mut t = format!(
+            "ply\nformat ascii 1.0\nelement vertex {vertices}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float nx\nproperty float ny\nproperty float nz\nproperty float s\nproperty float t\n\
+             element edge 2\nproperty int a\nproperty int b\n\
+             element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+            vertices - 3
+        );
+        for i in 0..vertices {
+            let f = i as f32;
+            t += &format!("{} {} {} 0 0 1 {} {}\r\n", f * 0.5, f * 0.25 - 3.0, 1.0 / (f + 1.0), f / 7.0, f / 11.0);
+            if i % 5 == 2 {
+                t += "   \n\n";
+            }
+        }
+        t += "0 1\n\n1 2\n";
+        for i in 0..vertices - 3 {
+            if i % 3 == 0 {
+                t += &format!("4 {} {} {} {}\n", i, i + 1, i + 2, i + 3)
+            } else {
+                t += &format!("3 {} {} {}\n", i, i + 1, i + 2)
+            }
+        }
+        t
+    }
+
+    fn same(a: &PlyData, b: &PlyData) -> bool {
+        a.positions == b.positions && a.triangles == b.triangles && a.normals == b.normals && a.uvs == b.uvs
+    }
+
+    /// The chunked ASCII reader gives exactly the serial reader's data, for
+    /// chunks from 1 line to more than the file, and exactly its error (the
+    /// first in the file) for a bad number, an index out of range and a
+    /// truncated file.
+    #[test]
+    fn chunked_ascii_equals_serial() {
+        let path = Path::new("t.ply");
+        let good = text(40);
+        let serial = parse_in(good.as_bytes(), path, None).unwrap();
+        assert_eq!(serial.positions.len(), 40);
+        assert!(serial.triangles.len() > 37);
+        for chunk in [1, 2, 3, 7, 16, 1000] {
+            let chunked = parse_in(good.as_bytes(), path, Some(chunk)).unwrap();
+            assert!(same(&serial, &chunked), "chunks of {chunk}");
+        }
+        let bad_number = good.replacen("\n10 2 ", "\n10 x2 ", 1);
+        let out_of_range = good.replacen("3 20 21 22", "3 20 21 99", 1);
+        let truncated = good[..good.len() - 30].to_string();
+        for bad in [bad_number, out_of_range, truncated] {
+            assert_ne!(bad, good);
+            let want = parse_in(bad.as_bytes(), path, None).err().expect("an error").to_string();
+            for chunk in [1, 3, 16] {
+                let got = parse_in(bad.as_bytes(), path, Some(chunk)).err().expect("an error").to_string();
+                assert_eq!(got, want);
+            }
+        }
+    }
 }

@@ -128,7 +128,7 @@ impl DensityGrid {
             t0 = t0.max(ta.min(tb));
             t1 = t1.min(ta.max(tb));
         }
-        if !(t0 < t1) {
+        if t0.partial_cmp(&t1) != Some(std::cmp::Ordering::Less) {
             return seg;
         }
         let p = o + d * t0;
@@ -246,7 +246,7 @@ impl Iterator for Segments<'_> {
 
     #[inline]
     fn next(&mut self) -> Option<(f32, f32, f32)> {
-        if !(self.t < self.end) {
+        if self.t.partial_cmp(&self.end) != Some(std::cmp::Ordering::Less) {
             return None;
         }
         let a = if self.next[0] <= self.next[1] && self.next[0] <= self.next[2] {

@@ -220,7 +220,7 @@ impl Medium {
         let mut t = Spectrum::ONE;
         'walk: for (t0, t1, bound) in g.grid.segments(o, du, d) {
             let mu = sigma_max * bound;
-            if !(mu > 0.0) {
+            if mu.is_nan() || mu <= 0.0 {
                 continue;
             }
             let mut s = t0;
@@ -300,7 +300,7 @@ impl Medium {
         for (t0, t1, bound) in g.grid.segments(o, du, t_max) {
             // A hero that does not interact, or an empty cell, has no collision.
             let mu = sigma_j * bound;
-            if !(mu > 0.0) {
+            if mu.is_nan() || mu <= 0.0 {
                 walked += bound * (t1 - t0);
                 continue;
             }

@@ -8,7 +8,7 @@
 //! at the bottom. A medium around the camera is therefore a volume too: the
 //! loader adds one object, an index-matched sphere (`Interface`) whose interior
 //! is the named medium, enclosing every bounded object and the eye with a 5%
-//! margin ([`world_volume`]). Everything else follows from what volumes
+//! margin (`world_volume`). Everything else follows from what volumes
 //! already do, in every integrator: the camera's paths start inside it
 //! (`Scene::camera_volumes`), light subpaths from the environment or a distant
 //! light enter it from outside, shadow rays sum its optical depth, and an
@@ -26,7 +26,7 @@
 //! # `exterior:`
 //! pbrt-v4 and Mitsuba 3 give every surface an inside and an outside medium;
 //! rust-v derives the outside from the nesting. An object may still say which
-//! medium it expects outside (`exterior: "haze"`): [`check_exteriors`] finds
+//! medium it expects outside (`exterior: "haze"`): `check_exteriors` finds
 //! a point just outside its surface, takes the volumes around that point
 //! without the object itself, and refuses the scene, naming the field, when
 //! the current one's medium is another (or vacuum). So a declaration can never
