@@ -61,6 +61,7 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
     let mut p = parser::Parser::new(ctx, path, text.to_string(), strict);
     p.run()?;
     p.resolve_plys()?;
+    p.resolve_media()?;
     let warnings = p.warning_lines();
     let b = std::mem::take(&mut p.built);
     let camera = b.camera.ok_or_else(|| crate::error::Error::scene_field(path, "", "the file has no WorldBegin"))?;
@@ -69,7 +70,7 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
             camera,
             render: b.render,
             materials: NamedMap(b.materials),
-            media: NamedMap(Vec::new()),
+            media: NamedMap(b.media),
             objects: b.objects,
             lights: b.lights,
             environment: b.environment,

@@ -197,6 +197,19 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         written.push(path);
         o.shape = ShapeDesc::Mesh { path: name, scale: None, rotate_deg: None, translate: None };
     }
+    // A `uniformgrid`'s density, made in memory by the import, as a file beside the output.
+    for (k, (_, m)) in desc.media.0.iter_mut().filter(|(_, m)| matches!(m, MediumDesc::Grid { .. })).enumerate() {
+        let MediumDesc::Grid { path, .. } = m else { continue };
+        let Some(bytes) = ctx.provided(path) else { continue };
+        let name = format!("{stem}-medium-{k}.vol");
+        let at = out_dir.join(&name);
+        write_atomic(&at, &bytes)?;
+        written.push(at);
+        *path = name;
+    }
+    if let Some(EnvironmentDesc::Image { path, .. }) = desc.environment.as_mut() {
+        *path = relative(&ctx.dir.join(&*path), &out_dir);
+    }
     for (_, m) in desc.materials.0.iter_mut() {
         use crate::scene::desc::MaterialDesc as M;
         match m {

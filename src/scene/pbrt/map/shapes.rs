@@ -105,11 +105,20 @@ impl Parser<'_> {
             MatRef::Name(n) => Some(n.clone()),
             MatRef::Default => Some(self.default_material()),
             MatRef::Interface if rec.area.is_some() => None,
+            MatRef::Interface if !rec.inside.is_empty() => Some(self.interface_material()),
             MatRef::Interface => {
-                self.warn(at, "a shape with the interface material (a medium's boundary) is left out")?;
+                self.interior_of(rec, false)?;
+                self.warn(at, "a shape with the interface material and no medium inside is left out")?;
                 return Ok(());
             }
         };
+        let bounds_volume = material.as_ref().is_some_and(|n| {
+            self.built
+                .materials
+                .iter()
+                .any(|(k, m)| k == n && matches!(m, MaterialDesc::Dielectric { .. } | MaterialDesc::Interface))
+        });
+        let interior = self.interior_of(rec, bounds_volume)?;
         let emission = rec.area.as_ref().map(|a| a.emission(area));
         let two_sided = rec.area.as_ref().is_some_and(|a| a.two_sided);
         if let Some((file, floc)) = pending {
@@ -123,6 +132,9 @@ impl Parser<'_> {
                 reverse: rec.reverse,
                 area: rec.area.clone(),
             });
+        }
+        if let Some(name) = interior {
+            self.built.interiors.push((self.built.objects.len(), name, at));
         }
         self.built.objects.push(ObjectDesc {
             shape,
@@ -199,6 +211,15 @@ impl Parser<'_> {
             }
         }
         Ok(())
+    }
+
+    /// The index-matched boundary of a medium (pbrt's `interface` material).
+    pub(super) fn interface_material(&mut self) -> String {
+        let name = "pbrt-interface".to_string();
+        if !self.built.materials.iter().any(|(k, _)| *k == name) {
+            self.built.materials.push((name.clone(), MaterialDesc::Interface));
+        }
+        name
     }
 
     pub(super) fn default_material(&mut self) -> String {
