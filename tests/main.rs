@@ -27,3 +27,4 @@ mod scenes;
 mod spectra;
 mod spectral;
 mod stability;
+mod surround;

@@ -254,6 +254,12 @@ pub struct CameraDesc {
     /// A lens system in front of a film, instead of the pinhole or thin lens.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lens: Option<LensDesc>,
+    /// The name of a medium in `media` that the camera sits in: it fills the
+    /// space around the scene, out to a sphere enclosing every bounded object
+    /// and the eye (vacuum beyond, so the environment and distant lights are
+    /// seen through the haze's thickness): `medium: "haze"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub medium: Option<String>,
 }
 
 /// A lens system camera: a lens file (pbrt's format, with an optional glass
@@ -597,6 +603,12 @@ pub struct ObjectDesc {
     /// material must be a `Dielectric` or an `Interface`): `interior: "milk"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interior: Option<String>,
+    /// The name of the medium just outside the object's surface, as a check:
+    /// rust-v finds the outside from the volumes around the object (nesting
+    /// and `priority`), and the scene is refused when they disagree:
+    /// `exterior: "haze"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exterior: Option<String>,
 }
 
 /// An object's placement, applied to its shape: scale, then rotate about x, then y,

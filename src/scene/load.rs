@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::check::{Check, Input, MAX_MAGNITUDE};
 use super::desc::{CameraDesc, LensDesc, SceneDesc, ShapeDesc};
-use super::{Object, Scene};
+use super::{Object, Scene, surround};
 use crate::bxdf::Bxdf;
 use crate::camera::lens_system::{D_LINE_NM, LensSystem};
 use crate::camera::{Camera, LensCamera};
@@ -288,13 +288,26 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     if objects.is_empty() {
         return Err(ctx.err("objects", "expected at least one object"));
     }
+    // The camera's medium: a volume around the whole scene (`surround`).
+    let mut names: Vec<Option<&str>> = desc.objects.iter().map(|o| o.interior.as_deref()).collect();
+    if let Some(name) = &desc.camera.medium {
+        let m = media.get(name.as_str()).ok_or_else(|| {
+            let known: Vec<&str> = media.keys().copied().collect();
+            ctx.err("camera.medium", format!("unknown medium \"{name}\"; defined: {}", known.join(", ")))
+        })?;
+        let eye = ctx.vec("camera.eye", desc.camera.eye)?;
+        materials.push(Bxdf::Interface);
+        textures.push(None);
+        objects.push(surround::world_volume(ctx, &objects, eye, m, materials.len() as u32 - 1)?);
+        names.push(Some(name.as_str()));
+    }
+    let known: Vec<&str> = media.keys().copied().collect();
+    surround::check_exteriors(ctx, &desc.objects, &objects, &materials, &names, &known)?;
     if let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.is_grid()))
         && settings.integrator == IntegratorKind::Whitted
     {
-        return Err(ctx.err(
-            format!("objects[{i}].interior"),
-            "a Grid medium: whitted does not track media; use auto, path or spectral",
-        ));
+        let field = if i < desc.objects.len() { format!("objects[{i}].interior") } else { "camera.medium".into() };
+        return Err(ctx.err(field, "a Grid medium: whitted does not track media; use auto, path or spectral"));
     }
 
     let c = &desc.camera;

@@ -14,6 +14,7 @@ pub mod pbrt;
 mod position;
 mod query;
 mod spectra;
+pub mod surround;
 
 pub use load::{load_scene, load_scene_str, load_scene_with_warnings};
 pub use query::{Clear, Emitted, LightChoice, MAX_PASSES};

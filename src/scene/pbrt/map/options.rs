@@ -170,6 +170,7 @@ impl Parser<'_> {
             aperture_radius: cam.lens_radius as f32,
             focus_distance: (cam.lens_radius > 0.0).then_some(cam.focal_distance as f32),
             lens: None,
+            medium: None,
         });
         Ok(())
     }

@@ -144,6 +144,7 @@ impl Parser<'_> {
             priority: 0,
             transform: None,
             interior: None,
+            exterior: None,
         });
         self.built.mesh_files.push(mesh_file);
         Ok(())
