@@ -213,3 +213,35 @@ fn hostile_media_give_one_error_line_at_the_place() {
         assert!(e.contains(&format!("{name}{place}")) && e.contains(what), "{name}: expected {place} {what:?}: {e}");
     }
 }
+
+#[test]
+fn the_camera_sits_in_the_outside_medium_at_camera_and_outside_media_become_exteriors() {
+    let d = temp_dir("pbrt-media-camera");
+    // pbrt-v4's scene.cpp: `CameraSceneEntity(..., graphicsState.currentOutsideMedium)`.
+    let p = write(
+        &d,
+        "s.pbrt",
+        "MediumInterface \"\" \"fog\"\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 60\n\
+         Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 24\nSampler \"zsobol\" \"integer pixelsamples\" 4\n\
+         WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+         MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.01 0.01 0.01] \"rgb sigma_s\" [0.05 0.05 0.05]\n\
+         MakeNamedMedium \"smoke\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [2 2 2]\n\
+         AttributeBegin\n MediumInterface \"smoke\" \"fog\"\n Material \"interface\"\n Shape \"sphere\" \"float radius\" 0.8\nAttributeEnd\n\
+         AttributeBegin\n Translate 0 -1 0\n Rotate -90 1 0 0\n Material \"diffuse\"\n Shape \"disk\" \"float radius\" 3\nAttributeEnd\n\
+         AttributeBegin\n MediumInterface \"fog\" \"fog\"\n Translate 1.5 0 0\n Material \"dielectric\"\n Shape \"sphere\" \"float radius\" 0.3\nAttributeEnd\n",
+    );
+    let (desc, w) = read_pbrt(&p, true).expect("no warnings with strict");
+    assert!(w.is_empty(), "{w:?}");
+    assert_eq!(desc.camera.medium.as_deref(), Some("fog"));
+    let media = |i: usize| (desc.objects[i].interior.as_deref(), desc.objects[i].exterior.as_deref());
+    // A boundary between smoke and fog; the disk (MediumInterface "" "fog" still
+    // current from before WorldBegin) has fog outside; the glass with fog on both
+    // sides is no transition in pbrt-v4 (the ray keeps its medium): fog inside, no check.
+    assert_eq!(media(0), (Some("smoke"), Some("fog")));
+    assert_eq!(media(1), (None, Some("fog")));
+    assert_eq!(media(2), (Some("fog"), None));
+    let scene = load_scene(&p, &small()).expect("the exteriors agree with the nesting");
+    let text = convert(&p, &d);
+    assert!(text.contains("medium: \"fog\"") && text.contains("exterior: \"fog\""), "{text}");
+    assert_same_films(&film_of(&scene), &film_of(&load_scene(&d.join("out.ron"), &small()).unwrap()));
+}

@@ -42,7 +42,8 @@ fn a_camera_in_a_medium_of_albedo_one_sees_a_furnace() {
     // ∫ r⁻⁴ r² dr, diverges (at 2048 spp the image mean was 1.33 ± 0.38). No
     // tolerance can be stated, so only finiteness is asserted (render_str
     // refuses NaN and infinite samples); docs/failure-matrix.md has the row.
-    let film = render_str(&furnace, &SettingsPatch { integrator: Some(IntegratorKind::LightTrace), ..Default::default() });
+    let film =
+        render_str(&furnace, &SettingsPatch { integrator: Some(IntegratorKind::LightTrace), ..Default::default() });
     assert!(mean_and_stderr(&film, 1).0.is_finite());
     let film = render_str(&haze(0.5, 0.5, white, "environment: Uniform(Constant(1))"), &SettingsPatch::default());
     let (mean, se) = mean_and_stderr(&film, 1);

@@ -124,6 +124,8 @@ pub(crate) struct Built {
     pub(crate) media: Vec<(String, MediumDesc)>,
     /// Objects with an interior medium: the object, the medium's name and the shape's place.
     interiors: Vec<(usize, String, Loc)>,
+    /// Objects with an outside medium, as `interiors`.
+    exteriors: Vec<(usize, String, Loc)>,
     /// The outside medium at the `Camera` directive and its place.
     pub(crate) camera_medium: Option<(String, Loc)>,
     anonymous: usize,
@@ -164,6 +166,7 @@ impl Default for Built {
             named_media: Vec::new(),
             media: Vec::new(),
             interiors: Vec::new(),
+            exteriors: Vec::new(),
             camera_medium: None,
             anonymous: 0,
             triangles: 0,

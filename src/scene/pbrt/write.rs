@@ -208,7 +208,17 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         *path = name;
     }
     if let Some(EnvironmentDesc::Image { path, .. }) = desc.environment.as_mut() {
-        *path = relative(&ctx.dir.join(&*path), &out_dir);
+        match ctx.provided(path) {
+            // A map the import flipped in memory (see `map/lights.rs`).
+            Some(bytes) => {
+                let name = format!("{stem}-envmap.exr");
+                let at = out_dir.join(&name);
+                write_atomic(&at, &bytes)?;
+                written.push(at);
+                *path = name;
+            }
+            None => *path = relative(&ctx.dir.join(&*path), &out_dir),
+        }
     }
     for (_, m) in desc.materials.0.iter_mut() {
         use crate::scene::desc::MaterialDesc as M;

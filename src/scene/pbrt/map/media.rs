@@ -285,18 +285,15 @@ impl Parser<'_> {
         Ok(())
     }
 
-    /// The interior medium of a shape: `inside` of its `MediumInterface`, kept for
-    /// a material that bounds a volume (a dielectric or the interface), resolved
-    /// after parsing ([`Parser::resolve_media`]).
-    pub(crate) fn interior_of(&mut self, rec: &ShapeRec, bounds_volume: bool) -> Result<Option<String>> {
-        if !rec.outside.is_empty() && rec.outside != rec.inside {
-            self.warn(
-                rec.loc,
-                format!("MediumInterface: the outside medium \"{}\" is not carried over (rust-v's objects have an interior only)", rec.outside),
-            )?;
-        }
+    /// The media of a shape's `MediumInterface`: its interior (`inside`, kept for a
+    /// material that bounds a volume: a dielectric or the interface) and its
+    /// exterior (`outside`, where the surface is a transition between two media, as
+    /// pbrt-v4 uses it; a check in rust-v), both resolved after parsing
+    /// ([`Parser::resolve_media`]).
+    pub(crate) fn media_of(&mut self, rec: &ShapeRec, bounds_volume: bool) -> (Option<String>, Option<String>) {
+        let exterior = (!rec.outside.is_empty() && rec.outside != rec.inside).then(|| rec.outside.clone());
         if rec.inside.is_empty() {
-            return Ok(None);
+            return (None, exterior);
         }
         if !bounds_volume {
             self.note(
@@ -306,9 +303,9 @@ impl Parser<'_> {
                     rec.inside
                 ),
             );
-            return Ok(None);
+            return (None, exterior);
         }
-        Ok(Some(rec.inside.clone()))
+        (Some(rec.inside.clone()), exterior)
     }
 
     /// Checks every medium named by a shape or the camera and places the grids:
@@ -324,11 +321,35 @@ impl Parser<'_> {
             };
             self.built.objects[object].interior = placed;
         }
+        // Outside media are named as they are (a grid by the medium that holds it
+        // voxel for voxel, if one does).
+        let exteriors = std::mem::take(&mut self.built.exteriors);
+        for (object, name, loc) in exteriors {
+            let Some(k) = self.medium_index(&name, loc)? else { continue };
+            let named = match &self.built.named_media[k].kind {
+                Kind::Homogeneous(_) => Some(name.clone()),
+                Kind::Grid(g) => g.exact.clone(),
+                Kind::Unsupported => None,
+            };
+            if named.is_none() {
+                self.note(loc, format!("MediumInterface: the outside medium \"{name}\" is not checked (a medium rust-v holds under another name or not at all)"));
+            }
+            self.built.objects[object].exterior = named;
+        }
+        // pbrt-v4: the camera sits in the outside medium of the MediumInterface at `Camera`.
         if let Some((name, loc)) = self.built.camera_medium.take()
             && !name.is_empty()
-            && self.medium_index(&name, loc)?.is_some()
+            && let Some(k) = self.medium_index(&name, loc)?
         {
-            self.warn(loc, format!("the camera's medium \"{name}\" (the outside of the MediumInterface at Camera) is not carried over: the camera sits in vacuum"))?;
+            match &self.built.named_media[k].kind {
+                Kind::Homogeneous(_) => {
+                    if let Some(c) = self.built.camera.as_mut() {
+                        c.medium = Some(name);
+                    }
+                }
+                Kind::Grid(_) => self.warn(loc, format!("the camera's medium \"{name}\" is a uniformgrid: rust-v's camera medium is homogeneous (the camera sits in vacuum)"))?,
+                Kind::Unsupported => {}
+            }
         }
         Ok(())
     }

@@ -105,10 +105,10 @@ impl Parser<'_> {
             MatRef::Name(n) => Some(n.clone()),
             MatRef::Default => Some(self.default_material()),
             MatRef::Interface if rec.area.is_some() => None,
-            MatRef::Interface if !rec.inside.is_empty() => Some(self.interface_material()),
+            // A boundary between two media (vacuum inside: a clear volume).
+            MatRef::Interface if rec.inside != rec.outside => Some(self.interface_material()),
             MatRef::Interface => {
-                self.interior_of(rec, false)?;
-                self.warn(at, "a shape with the interface material and no medium inside is left out")?;
+                self.warn(at, "a shape with the interface material and the same medium on both sides is left out")?;
                 return Ok(());
             }
         };
@@ -118,7 +118,7 @@ impl Parser<'_> {
                 .iter()
                 .any(|(k, m)| k == n && matches!(m, MaterialDesc::Dielectric { .. } | MaterialDesc::Interface))
         });
-        let interior = self.interior_of(rec, bounds_volume)?;
+        let (interior, exterior) = self.media_of(rec, bounds_volume);
         let emission = rec.area.as_ref().map(|a| a.emission(area));
         let two_sided = rec.area.as_ref().is_some_and(|a| a.two_sided);
         if let Some((file, floc)) = pending {
@@ -135,6 +135,9 @@ impl Parser<'_> {
         }
         if let Some(name) = interior {
             self.built.interiors.push((self.built.objects.len(), name, at));
+        }
+        if let Some(name) = exterior {
+            self.built.exteriors.push((self.built.objects.len(), name, at));
         }
         self.built.objects.push(ObjectDesc {
             shape,
