@@ -201,6 +201,15 @@ fn hostile_media_give_one_error_line_at_the_place() {
             "expected non-negative coefficients",
         ),
         (
+            // pbrt trusts the declared outside; rust-v checks it (the camera is in vacuum here).
+            "exterior.pbrt",
+            format!(
+                "{HEAD}MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"\" \"fog\"\nShape \"sphere\"\n"
+            ),
+            ":8:7:",
+            "objects[0].exterior (this Shape): \"fog\", but just outside its surface is vacuum",
+        ),
+        (
             "type.pbrt",
             format!("{HEAD}MakeNamedMedium \"fog\" \"string type\" \"vapour\"\n{sphere}"),
             ":6:23:",

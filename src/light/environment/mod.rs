@@ -18,6 +18,15 @@
 //! `rotate_deg: (x, y, z)` turns the map about X, then Y, then Z, as an
 //! object's `transform` turns a shape (`docs/scene-format.md` has a picture).
 //!
+//! With `mapping: EqualArea` the image is the equal-area octahedral square of
+//! pbrt-v4's image infinite lights (Clarberg 2008), square: its centre looks up
+//! (+y), its corners down, u grows towards +x and v towards +z; the inner
+//! diamond `|u − ½| + |v − ½| < ½` is the upper hemisphere (`map::to_square`,
+//! `map::from_square`: pbrt-v4's `EqualAreaSphereToSquare` layout for the
+//! direction `(x, z, y)`, pbrt's light space having +z up). Bilinear lookups
+//! fold across the square's edges onto the texels that border the same
+//! directions (`map::fold_square`, pbrt's `octahedralsphere` wrap).
+//!
 //! # Radiance and sampling
 //! Each texel's linear sRGB colour becomes an emission spectrum as `Rgb(...)`
 //! does for an emitter (`crate::color::rgb_emission`: the Jakob-Hanika sigmoid
@@ -31,7 +40,9 @@
 //! spreads a texel's radiance into its neighbours' cells, so every cell where
 //! the radiance is not zero has a non-zero density: no bias) times `sin θ`
 //! (the solid angle of a row). A point `(u, v)` of density `p(u, v)` is a
-//! direction of density `p(u, v) / (2π² sin θ)` per solid angle. `Uniform`
+//! direction of density `p(u, v) / (2π² sin θ)` per solid angle. An equal-area
+//! map's texels all span `4π/(w·h)`: its weights have no `sin θ` and a point of
+//! density `p(u, v)` is a direction of density `p(u, v) / 4π`. `Uniform`
 //! samples the sphere uniformly (`1/4π`).
 //!
 //! Light subpaths (BDPT, light tracing) start from the environment as pbrt-v4

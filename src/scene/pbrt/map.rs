@@ -109,6 +109,8 @@ pub(crate) struct Built {
     pub(crate) objects: Vec<ObjectDesc>,
     /// Per object: the PLY file (as written in the scene) its triangles came from.
     pub(crate) mesh_files: Vec<Option<String>>,
+    /// Per object: where its `Shape` is.
+    pub(crate) object_locs: Vec<Loc>,
     pub(crate) lights: Vec<LightDesc>,
     pub(crate) environment: Option<EnvironmentDesc>,
     pub(crate) camera: Option<CameraDesc>,
@@ -146,6 +148,7 @@ impl Default for Built {
             textures: HashMap::new(),
             objects: Vec::new(),
             mesh_files: Vec::new(),
+            object_locs: Vec::new(),
             lights: Vec::new(),
             environment: None,
             camera: None,

@@ -15,9 +15,9 @@ mod map;
 mod parser;
 mod write;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::scene::check::Check;
 use crate::scene::desc::{NamedMap, SceneDesc};
 
@@ -31,6 +31,27 @@ pub(crate) struct Imported {
     pub(crate) warnings: Vec<String>,
     /// Per object: the PLY file its triangles came from, if any.
     pub(crate) mesh_files: Vec<Option<String>>,
+    /// Per object: the file, line and column of its `Shape` (see [`locate`]).
+    pub(crate) places: Vec<(PathBuf, usize, usize)>,
+}
+
+/// An error of the scene built from a pbrt file about `objects[i]` (an `exterior:`
+/// that disagrees with the volumes around the shape, a grid medium under `whitted`)
+/// moved to the `Shape` directive of object `i` in `places`, the field kept in the
+/// message; any other error as it is.
+pub(crate) fn locate(places: &[(PathBuf, usize, usize)], e: Error) -> Error {
+    let Error::Scene { path, position: None, field, message } = e else { return e };
+    let index =
+        field.strip_prefix("objects[").and_then(|r| r.split_once(']')).and_then(|(i, _)| i.parse::<usize>().ok());
+    match index.and_then(|i| places.get(i)) {
+        Some((file, line, col)) => Error::Scene {
+            path: file.clone(),
+            position: Some((*line, *col)),
+            field: String::new(),
+            message: format!("{field} (this Shape): {message}"),
+        },
+        None => Error::Scene { path, position: None, field, message },
+    }
 }
 
 /// Whether `path` names a pbrt scene (`.pbrt`, any case).
@@ -65,6 +86,7 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
     let warnings = p.warning_lines();
     let b = std::mem::take(&mut p.built);
     let camera = b.camera.ok_or_else(|| crate::error::Error::scene_field(path, "", "the file has no WorldBegin"))?;
+    let places = b.object_locs.iter().map(|l| (p.files[l.file].clone(), l.line, l.col)).collect();
     Ok(Imported {
         desc: SceneDesc {
             camera,
@@ -77,5 +99,6 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
         },
         warnings,
         mesh_files: b.mesh_files,
+        places,
     })
 }

@@ -176,7 +176,7 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         Error::scene_field(scene, "", format!("byte {} is not UTF-8; expected UTF-8 text", e.valid_up_to()))
     })?;
     let ctx = Check::new(scene);
-    let Imported { mut desc, warnings, mesh_files } = super::import(&ctx, scene, text, strict)?;
+    let Imported { mut desc, warnings, mesh_files, .. } = super::import(&ctx, scene, text, strict)?;
     let out_dir = crate::io::parent_dir(output).to_path_buf();
     let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     let mut written = Vec::new();

@@ -150,6 +150,7 @@ impl Parser<'_> {
             exterior: None,
         });
         self.built.mesh_files.push(mesh_file);
+        self.built.object_locs.push(at);
         Ok(())
     }
 
