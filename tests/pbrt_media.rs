@@ -254,3 +254,34 @@ fn the_camera_sits_in_the_outside_medium_at_camera_and_outside_media_become_exte
     assert!(text.contains("medium: \"fog\"") && text.contains("exterior: \"fog\""), "{text}");
     assert_same_films(&film_of(&scene), &film_of(&load_scene(&d.join("out.ron"), &small()).unwrap()));
 }
+
+/// pbrt-v4's named media: `"preset" "Ketchup"` is Jensen et al.'s σa = (0.061, 0.97,
+/// 1.45) and σs′ = (0.18, 0.07, 0.03) per mm, as RGB coefficients, still times
+/// `scale` (the same description as writing them out); parameters beside a preset
+/// and an unknown preset warn.
+#[test]
+fn medium_presets_are_pbrts_table() {
+    let d = temp_dir("pbrt-media-preset");
+    let p = write(
+        &d,
+        "s.pbrt",
+        &format!(
+            "{HEAD}MakeNamedMedium \"k\" \"string type\" \"homogeneous\" \"string preset\" \"Ketchup\" \"float scale\" 0.5\n\
+             MakeNamedMedium \"e\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.061 0.97 1.45] \"rgb sigma_s\" [0.18 0.07 0.03] \"float scale\" 0.5\n\
+             MakeNamedMedium \"w\" \"string type\" \"homogeneous\" \"string preset\" \"Wholemilk\" \"rgb sigma_a\" [1 1 1]\n\
+             MakeNamedMedium \"u\" \"string type\" \"homogeneous\" \"string preset\" \"Custard\"\n\
+             Shape \"sphere\"\n"
+        ),
+    );
+    let (desc, w) = read_pbrt(&p, false).unwrap();
+    let show = |i: usize| format!("{:?}", desc.media.0[i].1);
+    assert_eq!(show(0), show(1));
+    assert!(show(0).contains("Samples"), "{}", show(0));
+    assert!(w.len() == 2 && w[0].contains("ignored with a preset") && w[1].contains("\"Custard\""), "{w:?}");
+    match &desc.media.0[3].1 {
+        MediumDesc::Homogeneous { sigma_a: SpectrumDesc::Constant(a), sigma_s: SpectrumDesc::Constant(s), .. } => {
+            assert_eq!((*a, *s), (1.0, 1.0), "pbrt's defaults")
+        }
+        other => panic!("{other:?}"),
+    }
+}
