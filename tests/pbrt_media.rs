@@ -237,7 +237,8 @@ fn the_camera_sits_in_the_outside_medium_at_camera_and_outside_media_become_exte
          MakeNamedMedium \"smoke\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.5 0.5 0.5] \"rgb sigma_s\" [2 2 2]\n\
          AttributeBegin\n MediumInterface \"smoke\" \"fog\"\n Material \"interface\"\n Shape \"sphere\" \"float radius\" 0.8\nAttributeEnd\n\
          AttributeBegin\n Translate 0 -1 0\n Rotate -90 1 0 0\n Material \"diffuse\"\n Shape \"disk\" \"float radius\" 3\nAttributeEnd\n\
-         AttributeBegin\n MediumInterface \"fog\" \"fog\"\n Translate 1.5 0 0\n Material \"dielectric\"\n Shape \"sphere\" \"float radius\" 0.3\nAttributeEnd\n",
+         AttributeBegin\n MediumInterface \"fog\" \"fog\"\n Translate 1.5 0 0\n Material \"dielectric\"\n Shape \"sphere\" \"float radius\" 0.3\nAttributeEnd\n\
+         AttributeBegin\n Translate -1.5 0 0\n Material \"interface\"\n Shape \"sphere\" \"float radius\" 0.3\nAttributeEnd\n",
     );
     let (desc, w) = read_pbrt(&p, true).expect("no warnings with strict");
     assert!(w.is_empty(), "{w:?}");
@@ -246,9 +247,13 @@ fn the_camera_sits_in_the_outside_medium_at_camera_and_outside_media_become_exte
     // A boundary between smoke and fog; the disk (MediumInterface "" "fog" still
     // current from before WorldBegin) has fog outside; the glass with fog on both
     // sides is no transition in pbrt-v4 (the ray keeps its medium): fog inside, no check.
+    // (The last sphere: `MediumInterface "" "fog"` is still current.)
     assert_eq!(media(0), (Some("smoke"), Some("fog")));
     assert_eq!(media(1), (None, Some("fog")));
     assert_eq!(media(2), (Some("fog"), None));
+    // An interface with vacuum inside and fog outside: a clear bubble in the fog.
+    assert_eq!(media(3), (None, Some("fog")));
+    assert_eq!(desc.objects[3].material.as_deref(), Some("pbrt-interface"));
     let scene = load_scene(&p, &small()).expect("the exteriors agree with the nesting");
     let text = convert(&p, &d);
     assert!(text.contains("medium: \"fog\"") && text.contains("exterior: \"fog\""), "{text}");
