@@ -1,5 +1,7 @@
-//! pbrt-v4's participating media: `MakeNamedMedium` (`homogeneous`, `uniformgrid`)
-//! and the media of `MediumInterface` on shapes, resolved after parsing.
+//! pbrt-v4's participating media: `MakeNamedMedium` (`homogeneous` with pbrt's
+//! presets, `uniformgrid`) and the media of `MediumInterface`, resolved after
+//! parsing: a shape's inside becomes its `interior:`, the outside of a transition
+//! its `exterior:`, and the outside medium at `Camera` the camera's `medium:`.
 //!
 //! A `uniformgrid`'s density is written in memory as a `.vol` file
 //! (`NAME-medium-K.vol`, [`Check::provide`](crate::scene::check::Check::provide)):
