@@ -158,3 +158,37 @@ fn a_map_bright_in_one_octant_lights_where_pbrt_does() {
         assert_same_films(&film_of(&scene), &film_of(&load_scene(&ron, &small()).unwrap()));
     }
 }
+
+/// `illuminance` scales a map as pbrt-v4's `lights.cpp` does: by E / k, k = 2π/(w·h)
+/// Σ Y cos θ over the upper hemisphere's texels, which for a white map (Y = 1) is
+/// (2π/N)·(N/4π)·∫ cos dω = π/2 over the hemisphere: E = 2 gives scale 4/π (1%: the
+/// sum over 32² texels). A map that is not square is one error at its `filename`.
+#[test]
+fn illuminance_scales_a_map_as_pbrt_does_and_a_wide_map_is_an_error_at_its_filename() {
+    let d = temp_dir("pbrt-envmap-illuminance");
+    exr(&d.join("white.exr"), 32, 32, &[[1.0; 3]; 32 * 32]);
+    exr(&d.join("wide.exr"), 4, 2, &[[1.0; 3]; 8]);
+    let head = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+    let p = write(
+        &d,
+        "s.pbrt",
+        &format!(
+            "{head}LightSource \"infinite\" \"string filename\" \"white.exr\" \"float illuminance\" 2\nShape \"sphere\"\n"
+        ),
+    );
+    let (desc, _) = rust_v::scene::pbrt::read_pbrt(&p, true).unwrap();
+    match desc.environment {
+        Some(rust_v::scene::desc::EnvironmentDesc::Image { scale, .. }) => {
+            let want = 4.0 / std::f32::consts::PI;
+            assert!((scale / want - 1.0).abs() < 0.01, "scale {scale}, want {want}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let p = write(
+        &d,
+        "w.pbrt",
+        &format!("{head}LightSource \"infinite\" \"string filename\" \"wide.exr\"\nShape \"sphere\"\n"),
+    );
+    let e = crate::pbrt::one_error(&rust_v(&["render", s(&p), "-o", s(&d.join("x.png"))]));
+    assert!(e.contains("w.pbrt:4:24: environment.path (from here)") && e.contains("square"), "{e}");
+}

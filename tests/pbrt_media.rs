@@ -207,7 +207,7 @@ fn hostile_media_give_one_error_line_at_the_place() {
                 "{HEAD}MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"\" \"fog\"\nShape \"sphere\"\n"
             ),
             ":8:7:",
-            "objects[0].exterior (this Shape): \"fog\", but just outside its surface is vacuum",
+            "objects[0].exterior (from here): \"fog\", but just outside its surface is vacuum",
         ),
         (
             "type.pbrt",

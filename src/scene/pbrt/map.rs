@@ -113,6 +113,8 @@ pub(crate) struct Built {
     pub(crate) object_locs: Vec<Loc>,
     pub(crate) lights: Vec<LightDesc>,
     pub(crate) environment: Option<EnvironmentDesc>,
+    /// Where the environment comes from (the map's `filename`, or the `LightSource`).
+    pub(crate) environment_loc: Option<Loc>,
     pub(crate) camera: Option<CameraDesc>,
     pending_camera: Option<PendingCamera>,
     pub(crate) render: SettingsPatch,
@@ -151,6 +153,7 @@ impl Default for Built {
             object_locs: Vec::new(),
             lights: Vec::new(),
             environment: None,
+            environment_loc: None,
             camera: None,
             pending_camera: None,
             // pbrt-v4's defaults when a directive is left out: a 1280x720 film, 16 samples

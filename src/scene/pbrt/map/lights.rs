@@ -82,6 +82,7 @@ impl Parser<'_> {
                 if self.built.environment.is_some() {
                     self.warn(at, "a second infinite light: only the last one is kept")?;
                 }
+                self.built.environment_loc = Some(at);
                 self.built.environment = Some(EnvironmentDesc::Uniform(light_spectrum(&s, rgb, scale * k)));
             }
             other => {
@@ -187,6 +188,7 @@ impl Parser<'_> {
         if self.built.environment.is_some() {
             self.warn(at, "a second infinite light: only the last one is kept")?;
         }
+        self.built.environment_loc = Some(floc);
         self.built.environment = Some(EnvironmentDesc::Image {
             path,
             scale: scale as f32,
