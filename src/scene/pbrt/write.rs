@@ -169,7 +169,7 @@ fn rebase(s: &mut SpectrumDesc, from: &Path, to: &Path) {
 }
 
 /// Converts the pbrt scene `scene` to the RON scene `output` (and its mesh files);
-/// returns the import's warnings and the mesh files written.
+/// returns the import's warnings and the files written beside it (meshes, grids, maps).
 pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>, Vec<PathBuf>)> {
     let bytes = read_input(scene)?;
     let text = std::str::from_utf8(bytes.strip_prefix(&[0xef, 0xbb, 0xbf]).unwrap_or(&bytes)).map_err(|e| {
