@@ -11,6 +11,8 @@
 //!   patches (the ColorChecker's order, approximate sRGB values) on a black grid.
 //! - `scenes/media/smoke.vol`: a 24³ density grid (Mitsuba's `.vol`, see
 //!   `rust_v::medium::grid`): a soft cloud of three overlapping blobs, 0 to about 1.
+//! - `scenes/media/plume.vol`: a 32x48x32 grid of a thin, rising, swirling plume of
+//!   puffs (0 to 0.9; zero in most of the box, as real smoke is: 93% of the voxels).
 //!
 //! Run: `cargo run --release --example make_textures` (from the repository root).
 
@@ -126,4 +128,30 @@ fn main() {
         .collect();
     std::fs::create_dir_all("scenes/media").unwrap();
     std::fs::write("scenes/media/smoke.vol", rust_v::medium::grid::write_vol([n, n, n], &data)).unwrap();
+
+    // A plume: puffs along a helix rising from the bottom centre, growing and thinning.
+    let (nx, ny, nz) = (32usize, 48usize, 32usize);
+    let puffs: Vec<([f32; 3], f32, f32)> = (0..40)
+        .map(|i| {
+            let h = i as f32 / 39.0;
+            let a = 5.0 * h;
+            let c = [0.5 + 0.18 * h * a.cos(), 0.06 + 0.86 * h, 0.5 + 0.18 * h * a.sin()];
+            (c, 0.035 + 0.07 * h, 1.0 - 0.6 * h)
+        })
+        .collect();
+    let plume: Vec<f32> = (0..nx * ny * nz)
+        .map(|k| {
+            let v = [k % nx, (k / nx) % ny, k / (nx * ny)];
+            let p = [(v[0] as f32 + 0.5) / nx as f32, (v[1] as f32 + 0.5) / ny as f32, (v[2] as f32 + 0.5) / nz as f32];
+            let d: f32 = puffs
+                .iter()
+                .map(|(c, r, w)| {
+                    let d2: f32 = (0..3).map(|i| (p[i] - c[i]).powi(2)).sum();
+                    w * (-d2 / (r * r)).exp()
+                })
+                .fold(0.0, f32::max);
+            if d < 0.02 { 0.0 } else { d.min(1.0) }
+        })
+        .collect();
+    std::fs::write("scenes/media/plume.vol", rust_v::medium::grid::write_vol([nx, ny, nz], &plume)).unwrap();
 }

@@ -7,15 +7,27 @@
 //! its object's bounding box), then `x·y·z` floats, x fastest, then y, then z.
 //!
 //! Values are samples at the voxel centres, blended trilinearly (clamped at
-//! the faces); outside the box the density is 0. [`DensityGrid::max`] is the
-//! majorant the tracking uses (one for the whole grid: a medium that is
-//! mostly thin wastes tentative collisions; a coarse majorant grid would
-//! spend fewer, see the module docs of `crate::medium`).
+//! the faces); outside the box the density is 0.
+//!
+//! # Majorants
+//! Tracking draws tentative collisions against a majorant, a bound on the
+//! density; the tighter it is, the fewer collisions are null. The grid keeps a
+//! coarse majorant grid (pbrt-v4's idea, written here): at most
+//! [`MAJORANT_CELLS`] cells per axis, each holding the largest voxel value
+//! that the trilinear blend can reach inside it (the voxels whose centres lie
+//! within the cell, one more on each side for the blend, and one more for
+//! rounding). [`DensityGrid::segments`] walks a ray through the cells
+//! (Amanatides and Woo's 3D DDA) and gives each piece of the ray with its
+//! cell's bound; a piece with bound 0 costs no collision at all. Where the
+//! density is mostly thin (smoke, clouds) most of the ray crosses such cells.
 
 use glam::Vec3;
 
 /// The most voxels a grid may have (a 512³ grid, 512 MiB of floats).
 pub const MAX_VOXELS: usize = 1 << 27;
+
+/// The most majorant cells per axis.
+pub const MAJORANT_CELLS: usize = 16;
 
 /// A scalar density on a voxel grid over the unit cube.
 #[derive(Clone, Debug, PartialEq)]
@@ -23,6 +35,10 @@ pub struct DensityGrid {
     n: [usize; 3],
     data: Vec<f32>,
     max: f32,
+    /// Majorant cells per axis.
+    cells: [usize; 3],
+    /// The bound of each majorant cell, x fastest.
+    cell_max: Vec<f32>,
 }
 
 impl DensityGrid {
@@ -45,7 +61,100 @@ impl DensityGrid {
             ));
         }
         let max = data.iter().copied().fold(0.0f32, f32::max);
-        Ok(DensityGrid { n, data, max })
+        let cells = n.map(|v| v.min(MAJORANT_CELLS));
+        let mut grid = DensityGrid { n, data, max, cells, cell_max: Vec::new() };
+        grid.cell_max = grid.majorants();
+        Ok(grid)
+    }
+
+    /// The bound of every majorant cell: the largest voxel among those whose
+    /// trilinear support reaches into the cell, plus one voxel of margin.
+    fn majorants(&self) -> Vec<f32> {
+        // The voxel range a cell's blend can read along an axis: cell c spans
+        // [c/m, (c+1)/m], voxel coordinates x = v·n − ½ there, and the blend
+        // reads ⌊x⌋ and ⌊x⌋ + 1; one voxel more each side for rounding.
+        let range = |axis: usize, c: usize| {
+            let (n, m) = (self.n[axis] as f64, self.cells[axis] as f64);
+            let lo = (c as f64 * n / m - 0.5).floor() as i64 - 1;
+            let hi = ((c + 1) as f64 * n / m - 0.5).floor() as i64 + 2;
+            (lo.max(0) as usize, (hi.max(0) as usize).min(self.n[axis] - 1))
+        };
+        let [cx, cy, cz] = self.cells;
+        let mut out = Vec::with_capacity(cx * cy * cz);
+        for z in 0..cz {
+            let (z0, z1) = range(2, z);
+            for y in 0..cy {
+                let (y0, y1) = range(1, y);
+                for x in 0..cx {
+                    let (x0, x1) = range(0, x);
+                    let mut m = 0.0f32;
+                    for vz in z0..=z1 {
+                        for vy in y0..=y1 {
+                            let row = (vz * self.n[1] + vy) * self.n[0];
+                            m = self.data[row + x0..=row + x1].iter().copied().fold(m, f32::max);
+                        }
+                    }
+                    out.push(m);
+                }
+            }
+        }
+        out
+    }
+
+    /// The pieces of the ray `o + d t` (unit-cube coordinates), `0 <= t <
+    /// t_max`, inside the grid's box, in order, each with the bound of the
+    /// majorant cell it crosses.
+    pub fn segments(&self, o: Vec3, d: Vec3, t_max: f32) -> Segments<'_> {
+        let mut seg = Segments {
+            grid: self,
+            cell: [0; 3],
+            step: [0; 3],
+            next: [f32::INFINITY; 3],
+            delta: [0.0; 3],
+            t: 0.0,
+            end: -1.0,
+        };
+        // Clip to the unit box (slabs; a zero direction component keeps the
+        // ray inside or outside that slab for good).
+        let (mut t0, mut t1) = (0.0f32, t_max);
+        for a in 0..3 {
+            if d[a] == 0.0 {
+                if !(0.0..=1.0).contains(&o[a]) {
+                    return seg;
+                }
+                continue;
+            }
+            let (ta, tb) = ((0.0 - o[a]) / d[a], (1.0 - o[a]) / d[a]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+        if !(t0 < t1) {
+            return seg;
+        }
+        let p = o + d * t0;
+        for a in 0..3 {
+            let m = self.cells[a];
+            let c = ((p[a] * m as f32) as isize).clamp(0, m as isize - 1) as usize;
+            seg.cell[a] = c;
+            if d[a] > 0.0 {
+                seg.step[a] = 1;
+                seg.next[a] = t0 + ((c + 1) as f32 / m as f32 - p[a]) / d[a];
+                seg.delta[a] = 1.0 / (m as f32 * d[a]);
+            } else if d[a] < 0.0 {
+                seg.step[a] = -1;
+                seg.next[a] = t0 + (c as f32 / m as f32 - p[a]) / d[a];
+                seg.delta[a] = -1.0 / (m as f32 * d[a]);
+            }
+        }
+        seg.t = t0;
+        seg.end = t1;
+        seg
+    }
+
+    /// The bound of majorant cell `c`.
+    #[inline]
+    fn cell_max(&self, c: [usize; 3]) -> f32 {
+        self.cell_max[(c[2] * self.cells[1] + c[1]) * self.cells[0] + c[0]]
     }
 
     /// Parses a `.vol` file (see the module docs).
@@ -118,6 +227,49 @@ impl DensityGrid {
     }
 }
 
+/// A ray's walk through the majorant cells ([`DensityGrid::segments`]): each
+/// item is `(t_enter, t_exit, bound)`, contiguous, in order.
+pub struct Segments<'a> {
+    grid: &'a DensityGrid,
+    cell: [usize; 3],
+    step: [i8; 3],
+    /// The ray parameter of the next cell boundary along each axis.
+    next: [f32; 3],
+    /// The ray parameter between boundaries along each axis.
+    delta: [f32; 3],
+    t: f32,
+    end: f32,
+}
+
+impl Iterator for Segments<'_> {
+    type Item = (f32, f32, f32);
+
+    #[inline]
+    fn next(&mut self) -> Option<(f32, f32, f32)> {
+        if !(self.t < self.end) {
+            return None;
+        }
+        let a = if self.next[0] <= self.next[1] && self.next[0] <= self.next[2] {
+            0
+        } else if self.next[1] <= self.next[2] {
+            1
+        } else {
+            2
+        };
+        let exit = self.next[a].min(self.end).max(self.t);
+        let item = (self.t, exit, self.grid.cell_max(self.cell));
+        self.t = exit;
+        let c = self.cell[a] as isize + self.step[a] as isize;
+        if exit >= self.end || c < 0 || c >= self.grid.cells[a] as isize {
+            self.end = -1.0;
+        } else {
+            self.cell[a] = c as usize;
+            self.next[a] += self.delta[a];
+        }
+        Some(item)
+    }
+}
+
 /// The bytes of a `.vol` file holding `grid`'s values (for tests and scripts).
 pub fn write_vol(n: [usize; 3], data: &[f32]) -> Vec<u8> {
     let mut out = b"VOL\x03".to_vec();
@@ -148,6 +300,44 @@ mod tests {
         assert_eq!(g.density(Vec3::new(0.0, 0.5, 0.5)), 1.0, "clamped at the face");
         assert_eq!(g.density(Vec3::new(1.1, 0.5, 0.5)), 0.0, "outside");
         assert_eq!(g.max(), 3.0);
+    }
+
+    /// The majorant walk: on random rays through a random sparse grid (a
+    /// coarser 16-cell majorant over 37x5x23 voxels), the pieces are
+    /// contiguous, cover exactly the parameters whose points lie in the unit
+    /// box (checked at 400 points per ray, away from the faces by 1e-4), and
+    /// the density at every checked point is at most its piece's bound.
+    #[test]
+    fn majorant_cells_bound_the_density_along_every_ray() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(7);
+        let n = [37usize, 5, 23];
+        let data: Vec<f32> = (0..n[0] * n[1] * n[2])
+            .map(|_| if rng.random::<f32>() < 0.1 { rng.random::<f32>() * 5.0 } else { 0.0 })
+            .collect();
+        let g = DensityGrid::new(n, data).unwrap();
+        for _ in 0..300 {
+            let o = Vec3::new(rng.random(), rng.random(), rng.random()) * 3.0 - Vec3::splat(1.0);
+            let d = (Vec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - Vec3::ONE).normalize();
+            let t_max = rng.random::<f32>() * 4.0;
+            let pieces: Vec<(f32, f32, f32)> = g.segments(o, d, t_max).collect();
+            for w in pieces.windows(2) {
+                assert_eq!(w[0].1, w[1].0, "contiguous");
+            }
+            for k in 0..400 {
+                let t = t_max * (k as f32 + 0.5) / 400.0;
+                let p = o + d * t;
+                let inside = p.cmpge(Vec3::splat(1e-4)).all() && p.cmple(Vec3::splat(1.0 - 1e-4)).all();
+                let piece = pieces.iter().find(|s| s.0 <= t && t < s.1);
+                match piece {
+                    Some(&(_, _, bound)) => assert!(g.density(p) <= bound, "density {} above {bound}", g.density(p)),
+                    None => assert!(!inside, "{p} in the box but in no piece"),
+                }
+                if !(p.cmpge(Vec3::splat(-1e-4)).all() && p.cmple(Vec3::splat(1.0 + 1e-4)).all()) {
+                    assert!(piece.is_none(), "{p} outside the box in a piece");
+                }
+            }
+        }
     }
 
     /// Bad files are refused with a message.

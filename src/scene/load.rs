@@ -277,7 +277,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
                 Some(Box::new(m))
             }
         };
-        objects.push(Object { shape, material, light, priority: o.priority, interior });
+        objects.push(Object { shape, material, light, priority: o.priority, interior, world: false });
     }
     for (i, l) in desc.lights.iter().enumerate() {
         lights.push(Light::from_desc(ctx, &format!("lights[{i}]"), l)?);

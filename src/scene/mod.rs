@@ -53,6 +53,10 @@ pub struct Object {
     /// The medium filling the object's volume (`interior:`, or a dielectric's
     /// `absorption:` as a medium that only absorbs); `None`: clear.
     pub interior: Option<Box<Medium>>,
+    /// True for the sphere holding the camera's medium ([`surround`]): it
+    /// encloses the scene, so the scene's bounding sphere (for distant and
+    /// environment lights) is that sphere itself, not the box around it.
+    pub world: bool,
 }
 
 /// The closest hit of a ray in the scene.
@@ -145,9 +149,20 @@ impl Scene {
                 None => unbounded.push(i as u32),
             }
         }
-        // A sphere around everything bounded and the camera, for distant lights.
-        let world = bounds.iter().fold(Aabb::new(camera.eye(), camera.eye()), |a, b| a.union(b));
-        let radius = (world.diagonal().length() * 0.5).max(1.0);
+        // A sphere around everything bounded and the camera, for distant lights:
+        // around the box of all but the camera medium's sphere, which is centred
+        // on that box and counts by its own radius.
+        let world = bounds
+            .iter()
+            .zip(&bounded)
+            .filter(|(_, i)| !objects[**i as usize].world)
+            .fold(Aabb::new(camera.eye(), camera.eye()), |a, (b, _)| a.union(b));
+        let mut radius = (world.diagonal().length() * 0.5).max(1.0);
+        for o in objects.iter().filter(|o| o.world) {
+            if let Shape::Sphere(s) = &o.shape {
+                radius = radius.max(s.center.distance(world.centroid()) + s.radius);
+            }
+        }
         for l in &mut lights {
             l.set_scene_bounds(world.centroid(), radius);
         }

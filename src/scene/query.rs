@@ -167,9 +167,14 @@ impl Scene {
     }
 
     /// True when some object's material scatters only into delta directions
-    /// (smooth glass, mirror, smooth metal, thin sheet).
+    /// (smooth glass, mirror, smooth metal, thin sheet). An index-matched
+    /// boundary (`Interface`) does not count: paths pass it without a vertex
+    /// ([`Scene::crossing`]), so light sampling reaches a delta light through it.
     pub fn has_delta_surface(&self) -> bool {
-        self.objects.iter().any(|o| self.materials[o.material as usize].is_delta())
+        self.objects.iter().any(|o| {
+            let m = &self.materials[o.material as usize];
+            m.is_delta() && !m.is_interface()
+        })
     }
 
     /// The emission leaving surface hit `si` back along `dir` (the direction

@@ -77,6 +77,7 @@ pub(crate) fn world_volume(
         light: None,
         priority: 0,
         interior: Some(Box::new(medium.placed(b.min, b.max))),
+        world: true,
     })
 }
 
