@@ -118,7 +118,16 @@ impl Parser<'_> {
                 .iter()
                 .any(|(k, m)| k == n && matches!(m, MaterialDesc::Dielectric { .. } | MaterialDesc::Interface))
         });
-        let (interior, exterior) = self.media_of(rec, bounds_volume);
+        // pbrt's inside is the side its normal points away from: a sphere that pbrt turns
+        // inside out has its "inside" medium around it (rust-v's spheres face outwards).
+        let inside_out = rec.ty == "sphere" && quadric_flip && (!rec.inside.is_empty() || !rec.outside.is_empty());
+        let (interior, exterior) = if inside_out {
+            self.note(at, "MediumInterface on a sphere that pbrt turns inside out (ReverseOrientation, or a mirroring transform): its \"inside\" medium is around it and its \"outside\" medium within it");
+            let swapped = ShapeRec { inside: rec.outside.clone(), outside: rec.inside.clone(), ..rec.clone() };
+            self.media_of(&swapped, bounds_volume)
+        } else {
+            self.media_of(rec, bounds_volume)
+        };
         let emission = rec.area.as_ref().map(|a| a.emission(area));
         let two_sided = rec.area.as_ref().is_some_and(|a| a.two_sided);
         if let Some((file, floc)) = pending {
