@@ -5,6 +5,8 @@
 //!   a blue sky graded to a pale horizon, a warm sun 5x5 texels wide at 35°
 //!   elevation towards +x, a bright overcast panel towards +z, and a
 //!   brown-grey ground.
+//! - `scenes/textures/outdoor-equal-area.exr`: the same sky as a 64x64 equal-area
+//!   square (`mapping: EqualArea`, pbrt-v4's layout: the centre looks up).
 //! - `scenes/textures/chart.png`: a 96x64 8-bit sRGB chart of 6x4 coloured
 //!   patches (the ColorChecker's order, approximate sRGB values) on a black grid.
 //! - `scenes/media/smoke.vol`: a 24³ density grid (Mitsuba's `.vol`, see
@@ -16,6 +18,38 @@
 
 use std::f32::consts::PI;
 
+/// The sky of `outdoor.exr` in direction `d` (+y up).
+fn sky(d: [f32; 3]) -> [f32; 3] {
+    if d[1] >= 0.0 {
+        let t = d[1].powf(0.4);
+        let mut c = [0.75 - 0.45 * t, 0.85 - 0.35 * t, 1.0 - 0.1 * t];
+        // The sun: towards +x, 35° up; 5x5 texels of about 200x the sky.
+        let sun = [35f32.to_radians().cos(), 35f32.to_radians().sin(), 0.0];
+        let cos = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
+        if cos > (5.0f32 * PI / 64.0 / 2.0).cos() {
+            c = [220.0, 190.0, 150.0];
+        }
+        // A soft bright panel towards +z, low in the sky.
+        if d[2] > 0.9 && d[1] < 0.35 {
+            c = c.map(|x| x * 4.0);
+        }
+        c
+    } else {
+        [0.22, 0.18, 0.14]
+    }
+}
+
+/// The direction of the equal-area square's point `(u, v)` in [0, 1]² (`mapping:
+/// EqualArea`: centre up, u towards +x, v towards +z; Clarberg 2008).
+fn equal_area_direction(u: f32, v: f32) -> [f32; 3] {
+    let (u, v) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    let signed = 1.0 - (u.abs() + v.abs());
+    let r = 1.0 - signed.abs();
+    let phi = if r == 0.0 { PI / 4.0 } else { ((v.abs() - u.abs()) / r + 1.0) * PI / 4.0 };
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    [phi.cos().copysign(u) * s, (1.0 - r * r).copysign(signed), phi.sin().copysign(v) * s]
+}
+
 fn main() {
     let (w, h) = (128u32, 64u32);
     let mut px = Vec::with_capacity((w * h * 3) as usize);
@@ -24,28 +58,21 @@ fn main() {
             let (u, v) = ((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
             let (theta, phi) = (PI * v, 2.0 * PI * u);
             let d = [theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos()];
-            let rgb = if d[1] >= 0.0 {
-                let t = d[1].powf(0.4);
-                let mut c = [0.75 - 0.45 * t, 0.85 - 0.35 * t, 1.0 - 0.1 * t];
-                // The sun: towards +x, 35° up; 5x5 texels of about 200x the sky.
-                let sun = [35f32.to_radians().cos(), 35f32.to_radians().sin(), 0.0];
-                let cos = d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2];
-                if cos > (5.0f32 * PI / 64.0 / 2.0).cos() {
-                    c = [220.0, 190.0, 150.0];
-                }
-                // A soft bright panel towards +z, low in the sky.
-                if d[2] > 0.9 && d[1] < 0.35 {
-                    c = c.map(|x| x * 4.0);
-                }
-                c
-            } else {
-                [0.22, 0.18, 0.14]
-            };
-            px.extend_from_slice(&rgb);
+            px.extend_from_slice(&sky(d));
         }
     }
     std::fs::create_dir_all("scenes/textures").unwrap();
     image::Rgb32FImage::from_raw(w, h, px).unwrap().save("scenes/textures/outdoor.exr").unwrap();
+    // The same sky as a 64x64 equal-area square.
+    let n = 64u32;
+    let mut px = Vec::with_capacity((n * n * 3) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let d = equal_area_direction((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+            px.extend_from_slice(&sky(d));
+        }
+    }
+    image::Rgb32FImage::from_raw(n, n, px).unwrap().save("scenes/textures/outdoor-equal-area.exr").unwrap();
 
     // Approximate sRGB (8-bit) of the 24 ColorChecker patches, row by row.
     const PATCHES: [[u8; 3]; 24] = [

@@ -21,6 +21,8 @@ mod memory;
 mod metrics;
 mod output;
 mod pbrt;
+mod pbrt_envmap;
+mod pbrt_media;
 mod sampler;
 mod scenes;
 mod sensor;

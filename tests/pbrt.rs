@@ -16,7 +16,7 @@ use rust_v::settings::SettingsPatch;
 
 use crate::common::{root, rust_v, temp_dir};
 
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+pub(crate) fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     if let Some(d) = p.parent() {
         std::fs::create_dir_all(d).unwrap();
@@ -25,11 +25,11 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-fn s(p: &Path) -> &str {
+pub(crate) fn s(p: &Path) -> &str {
     p.to_str().expect("utf-8 path")
 }
 
-fn film_of(scene: &Scene) -> Film {
+pub(crate) fn film_of(scene: &Scene) -> Film {
     let st = &scene.settings;
     let mut film = Film::new(st.width, st.height);
     let stop = AtomicBool::new(false);
@@ -38,13 +38,13 @@ fn film_of(scene: &Scene) -> Film {
     film
 }
 
-fn small() -> SettingsPatch {
+pub(crate) fn small() -> SettingsPatch {
     SettingsPatch { width: Some(24), height: Some(24), spp: Some(4), ..Default::default() }
 }
 
 /// The error line of a command that must fail with exit status 1: exactly one
 /// `rust-v: error:` line, no panic.
-fn one_error(o: &Output) -> String {
+pub(crate) fn one_error(o: &Output) -> String {
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(1), "exit status; stderr:\n{err}");
     assert!(!err.contains("panicked"), "a panic:\n{err}");
@@ -53,7 +53,7 @@ fn one_error(o: &Output) -> String {
     lines[0].to_string()
 }
 
-const HEAD: &str = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 90\n\
+pub(crate) const HEAD: &str = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 90\n\
 Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 24\nSampler \"zsobol\" \"integer pixelsamples\" 4\nWorldBegin\n";
 
 // ---------------------------------------------------------------------------
@@ -384,7 +384,7 @@ fn unsupported_things_warn_once_with_a_count_and_strict_makes_them_errors() {
 // ---------------------------------------------------------------------------
 // convert: the RON renders the same image bit for bit.
 
-fn assert_same_films(a: &Film, b: &Film) {
+pub(crate) fn assert_same_films(a: &Film, b: &Film) {
     let (x, y) = (a.mean_xyz(), b.mean_xyz());
     assert_eq!(x.len(), y.len());
     for (i, (p, q)) in x.iter().zip(&y).enumerate() {

@@ -21,16 +21,16 @@ pub fn convert_command(args: ConvertArgs) -> Result<()> {
     }
     check_output(&args.output, "output")?;
     check_aliasing(&[("scene", args.scene.as_path())], &[("output", args.output.as_path())])?;
-    let (warnings, meshes) = convert(&args.scene, &args.output, args.strict)?;
+    let (warnings, files) = convert(&args.scene, &args.output, args.strict)?;
     for w in &warnings {
         warn(format_args!("{w}"));
     }
     say(format_args!(
         "wrote {}{}",
         show_path(&args.output),
-        match meshes.len() {
+        match files.len() {
             0 => String::new(),
-            n => format!(" and {n} mesh file{}", if n == 1 { "" } else { "s" }),
+            n => format!(" and {n} file{} beside it (meshes, media grids, maps)", if n == 1 { "" } else { "s" }),
         }
     ));
     Ok(())

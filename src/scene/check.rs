@@ -44,12 +44,22 @@ pub(crate) struct Check<'a> {
     pub(crate) dir: PathBuf,
     /// Every file read so far, in order (for the scene's identity).
     pub(crate) inputs: RefCell<Vec<Input>>,
+    /// Files made in memory by an importer (a pbrt `uniformgrid` medium's density
+    /// as a `.vol`), by the name the description uses: [`Check::read_input`] serves
+    /// them instead of reading the disk. They are not inputs of their own: their
+    /// content comes from the scene's files, which are.
+    pub(crate) provided: RefCell<Vec<(String, Vec<u8>)>>,
 }
 
 impl<'a> Check<'a> {
     /// A context for the scene file at `path` (other files resolve relative to its folder).
     pub(crate) fn new(path: &'a Path) -> Check<'a> {
-        Check { path, dir: path.parent().map(Path::to_path_buf).unwrap_or_default(), inputs: RefCell::default() }
+        Check {
+            path,
+            dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            inputs: RefCell::default(),
+            provided: RefCell::default(),
+        }
     }
 }
 
@@ -61,12 +71,26 @@ impl Check<'_> {
 
     /// Reads a file the scene names (`rel`, relative to the scene file) for
     /// field `field`, and records it in the scene's identity. Only regular
-    /// files are read.
+    /// files are read. A file [`Check::provide`]d in memory is served from there.
     pub(crate) fn read_input(&self, field: &str, rel: &str) -> Result<(PathBuf, Vec<u8>)> {
         let path = self.dir.join(rel);
+        if let Some((_, bytes)) = self.provided.borrow().iter().find(|(name, _)| name == rel) {
+            return Ok((path, bytes.clone()));
+        }
         let bytes = read_input(&path).map_err(|e| self.err(field, e.to_string()))?;
         self.inputs.borrow_mut().push(Input { name: rel.to_string(), path: path.clone(), hash: fnv1a(&bytes) });
         Ok((path, bytes))
+    }
+
+    /// Makes `bytes` the content of the file `rel` for [`Check::read_input`] (a file an
+    /// importer makes in memory; nothing is written to disk).
+    pub(crate) fn provide(&self, rel: &str, bytes: Vec<u8>) {
+        self.provided.borrow_mut().push((rel.to_string(), bytes));
+    }
+
+    /// The bytes of a file made by [`Check::provide`], if `rel` is one.
+    pub(crate) fn provided(&self, rel: &str) -> Option<Vec<u8>> {
+        self.provided.borrow().iter().find(|(name, _)| name == rel).map(|(_, b)| b.clone())
     }
 
     /// Records a file read elsewhere (a mesh read ahead on the thread pool, see

@@ -64,8 +64,9 @@ pub struct SceneDesc {
 pub enum EnvironmentDesc {
     /// The same radiance from every direction: `Uniform(Constant(1))`.
     Uniform(SpectrumDesc),
-    /// An equirectangular map (PNG, sRGB-decoded, or EXR, linear), +y up:
-    /// `Image(path: "sky.exr", scale: 1, rotate_deg: (0, 90, 0))`.
+    /// An environment map (PNG, sRGB-decoded, or EXR, linear), +y up:
+    /// `Image(path: "sky.exr", scale: 1, rotate_deg: (0, 90, 0))`, equirectangular
+    /// unless `mapping: EqualArea` (pbrt-v4's square maps).
     Image {
         /// The image file, relative to the scene file.
         path: String,
@@ -75,6 +76,9 @@ pub enum EnvironmentDesc {
         /// Turns the map about X, then Y, then Z, in degrees (default none).
         #[serde(default)]
         rotate_deg: V3,
+        /// How the image covers the sphere (default `Equirectangular`).
+        #[serde(default, skip_serializing_if = "EnvMapping::is_equirectangular")]
+        mapping: EnvMapping,
     },
     /// The spectral Hosek-Wilkie sky with its sun, in absolute units
     /// (W m⁻² sr⁻¹ nm⁻¹): `Sky(sun_elevation_deg: 20, sun_azimuth_deg: 30, turbidity: 3, ground_albedo: 0.3)`.
@@ -94,6 +98,25 @@ pub enum EnvironmentDesc {
         #[serde(default = "one")]
         scale: f32,
     },
+}
+
+/// How an environment `Image` covers the sphere of directions
+/// (`crate::light::EnvironmentLight`'s module docs give the orientations).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+pub enum EnvMapping {
+    /// Latitude-longitude: rows from +y down to −y, u around +y (the default).
+    #[default]
+    Equirectangular,
+    /// The equal-area octahedral square (Clarberg 2008) of pbrt-v4's image
+    /// infinite lights: a square image, every texel the same solid angle, its
+    /// centre looking up (+y), its corners down.
+    EqualArea,
+}
+
+impl EnvMapping {
+    fn is_equirectangular(&self) -> bool {
+        *self == EnvMapping::Equirectangular
+    }
 }
 
 fn default_turbidity() -> f32 {

@@ -43,7 +43,7 @@ pub fn load_scene_with_warnings(path: &Path, overrides: &SettingsPatch, strict: 
     if super::pbrt::is_pbrt(path) {
         let ctx = Check::new(path);
         let imported = super::pbrt::import(&ctx, path, text, strict)?;
-        let scene = build(&ctx, imported.desc, overrides)?;
+        let scene = build(&ctx, imported.desc, overrides).map_err(|e| super::pbrt::locate(&imported.places, e))?;
         return Ok((identify(scene, ctx, &bytes), imported.warnings));
     }
     Ok((load(text, &bytes, path, overrides)?, Vec::new()))

@@ -1,18 +1,21 @@
-//! An `Image` environment: the equirectangular map, its texels and their
-//! sampling density, and the map's coordinates.
+//! An `Image` environment: the map (equirectangular or equal-area), its texels
+//! and their sampling density, and the map's coordinates.
 
-use std::f32::consts::PI;
+use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
 use crate::color::{Spectrum, Uplift, emission_spectrum, emission_uplift, fit_rows};
 use crate::sampler::piecewise::Piecewise2D;
+use crate::scene::desc::EnvMapping;
 
-/// An equirectangular map of emission texels and its sampling density.
+/// A map of emission texels and its sampling density.
 #[derive(Clone, Debug)]
 pub(super) struct EnvMap {
     pub(super) width: usize,
     pub(super) height: usize,
+    /// How the texels cover the sphere.
+    pub(super) mapping: EnvMapping,
     pub(super) texels: Vec<Texel>,
     /// Each texel's emission spectrum, evaluated once at load, for maps of at
     /// most [`CACHED_TEXELS`] texels (empty for larger ones, whose lookups
@@ -37,15 +40,14 @@ impl EnvMap {
     /// The bilinear blend of the four texels around `uv`.
     #[inline]
     pub(super) fn radiance(&self, uv: Vec2) -> Spectrum {
-        let (w, h) = (self.width as i64, self.height as i64);
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let (i0, i1) = ((x0 as i64).rem_euclid(w) as usize, (x0 as i64 + 1).rem_euclid(w) as usize);
-        let (j0, j1) = ((y0 as i64).clamp(0, h - 1) as usize, (y0 as i64 + 1).clamp(0, h - 1) as usize);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let at = |i: i64, j: i64| self.texel_index(i, j);
+        let k = [at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)];
         if !self.spectra.is_empty() {
-            let k = [j0 * self.width + i0, j0 * self.width + i1, j1 * self.width + i0, j1 * self.width + i1];
             let first = self.texels[k[0]];
             if k.iter().all(|&i| self.texels[i] == first) {
                 return self.spectra[k[0]];
@@ -60,10 +62,10 @@ impl EnvMap {
             return s;
         }
         let t = [
-            (self.texels[j0 * self.width + i0], (1.0 - fx) * (1.0 - fy)),
-            (self.texels[j0 * self.width + i1], fx * (1.0 - fy)),
-            (self.texels[j1 * self.width + i0], (1.0 - fx) * fy),
-            (self.texels[j1 * self.width + i1], fx * fy),
+            (self.texels[k[0]], (1.0 - fx) * (1.0 - fy)),
+            (self.texels[k[1]], fx * (1.0 - fy)),
+            (self.texels[k[2]], (1.0 - fx) * fy),
+            (self.texels[k[3]], fx * fy),
         ];
         if t.iter().all(|(texel, _)| *texel == t[0].0) {
             // One colour all round (a constant map): exactly that texel's spectrum.
@@ -77,6 +79,88 @@ impl EnvMap {
         }
         s
     }
+}
+
+impl EnvMap {
+    /// The map coordinates of a unit direction `m` in the map's frame.
+    #[inline]
+    pub(super) fn uv_of(&self, m: Vec3) -> Vec2 {
+        match self.mapping {
+            EnvMapping::Equirectangular => to_uv(m),
+            EnvMapping::EqualArea => to_square(m),
+        }
+    }
+
+    /// The texel at column `i`, row `j`, each possibly one beyond the image's edge:
+    /// equirectangular maps wrap around in `i` and clamp `j` at the poles; the
+    /// equal-area square folds over its edges onto the texels that border the
+    /// same directions (pbrt-v4's `WrapMode::OctahedralSphere`).
+    #[inline]
+    pub(super) fn texel_index(&self, i: i64, j: i64) -> usize {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let (i, j) = match self.mapping {
+            EnvMapping::Equirectangular => (i.rem_euclid(w), j.clamp(0, h - 1)),
+            EnvMapping::EqualArea => fold_square(i, j, w, h),
+        };
+        j as usize * self.width + i as usize
+    }
+}
+
+/// Texel `(i, j)` of a `w` x `h` equal-area square, one texel beyond an edge at
+/// most, folded onto the texel inside that borders the same directions: across
+/// the left or right edge the square continues mirrored top to bottom, across the
+/// top or bottom edge mirrored left to right (and both at a corner).
+#[inline]
+pub(super) fn fold_square(mut i: i64, mut j: i64, w: i64, h: i64) -> (i64, i64) {
+    if i < 0 || i >= w {
+        i = if i < 0 { -1 - i } else { 2 * w - 1 - i };
+        j = h - 1 - j;
+    }
+    if j < 0 || j >= h {
+        j = if j < 0 { -1 - j } else { 2 * h - 1 - j };
+        i = w - 1 - i;
+    }
+    (i.clamp(0, w - 1), j.clamp(0, h - 1))
+}
+
+/// The equal-area square's coordinates of a unit direction `m` in the map's frame
+/// (Clarberg 2008, "Fast Equal-Area Mapping of the (Hemi)Sphere using SIMD"; the
+/// layout of pbrt-v4's `EqualAreaSphereToSquare` for the direction `(m.x, m.z, m.y)`,
+/// pbrt's +z being the map's +y): the centre looks up (+y), the corners down (−y);
+/// u grows towards +x, v towards +z. Each octant is a triangle of the square, its
+/// area the octant's solid angle over 4π.
+#[inline]
+pub(super) fn to_square(m: Vec3) -> Vec2 {
+    let (a, b, up) = (m.x, m.z, m.y);
+    let (ax, ay) = (a.abs(), b.abs());
+    // The distance from the centre (|u| + |v| in [-1, 1]² coordinates) grows as √(1 − |up|).
+    let r = (1.0 - up.abs()).max(0.0).sqrt();
+    // The share of the quadrant's right angle from the u axis, in [0, 1].
+    let phi = if ax == 0.0 && ay == 0.0 { 0.0 } else { ay.atan2(ax) / FRAC_PI_2 };
+    let mut v = phi * r;
+    let mut u = r - v;
+    if up < 0.0 {
+        // The lower hemisphere: the outer triangles, folded over the diagonal.
+        (u, v) = (1.0 - v, 1.0 - u);
+    }
+    let (u, v) = (u.copysign(a), v.copysign(b));
+    Vec2::new((0.5 * (u + 1.0)).clamp(0.0, 1.0 - f32::EPSILON), (0.5 * (v + 1.0)).clamp(0.0, 1.0 - f32::EPSILON))
+}
+
+/// The unit direction in the map's frame of equal-area square coordinates `uv`
+/// (the inverse of [`to_square`]).
+#[inline]
+pub(super) fn from_square(uv: Vec2) -> Vec3 {
+    let (u, v) = (2.0 * uv.x - 1.0, 2.0 * uv.y - 1.0);
+    let (au, av) = (u.abs(), v.abs());
+    // Signed distance from the diagonal |u| + |v| = 1: positive inside (upper hemisphere).
+    let signed = 1.0 - (au + av);
+    let r = 1.0 - signed.abs();
+    let phi = if r == 0.0 { FRAC_PI_4 } else { ((av - au) / r + 1.0) * FRAC_PI_4 };
+    let up = (1.0 - r * r).copysign(signed);
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    let (sin_p, cos_p) = phi.sin_cos();
+    Vec3::new(cos_p.copysign(u) * s, up, sin_p.copysign(v) * s)
 }
 
 /// The map coordinates of a unit direction `m` in the map's frame.

@@ -18,6 +18,15 @@
 //! `rotate_deg: (x, y, z)` turns the map about X, then Y, then Z, as an
 //! object's `transform` turns a shape (`docs/scene-format.md` has a picture).
 //!
+//! With `mapping: EqualArea` the image is the equal-area octahedral square of
+//! pbrt-v4's image infinite lights (Clarberg 2008), square: its centre looks up
+//! (+y), its corners down, u grows towards +x and v towards +z; the inner
+//! diamond `|u − ½| + |v − ½| < ½` is the upper hemisphere (`map::to_square`,
+//! `map::from_square`: pbrt-v4's `EqualAreaSphereToSquare` layout for the
+//! direction `(x, z, y)`, pbrt's light space having +z up). Bilinear lookups
+//! fold across the square's edges onto the texels that border the same
+//! directions (`map::fold_square`, pbrt's `octahedralsphere` wrap).
+//!
 //! # Radiance and sampling
 //! Each texel's linear sRGB colour becomes an emission spectrum as `Rgb(...)`
 //! does for an emitter (`crate::color::rgb_emission`: the Jakob-Hanika sigmoid
@@ -31,7 +40,9 @@
 //! spreads a texel's radiance into its neighbours' cells, so every cell where
 //! the radiance is not zero has a non-zero density: no bias) times `sin θ`
 //! (the solid angle of a row). A point `(u, v)` of density `p(u, v)` is a
-//! direction of density `p(u, v) / (2π² sin θ)` per solid angle. `Uniform`
+//! direction of density `p(u, v) / (2π² sin θ)` per solid angle. An equal-area
+//! map's texels all span `4π/(w·h)`: its weights have no `sin θ` and a point of
+//! density `p(u, v)` is a direction of density `p(u, v) / 4π`. `Uniform`
 //! samples the sphere uniformly (`1/4π`).
 //!
 //! Light subpaths (BDPT, light tracing) start from the environment as pbrt-v4
@@ -53,14 +64,14 @@ use crate::io::image::decode_image;
 use crate::sampler::piecewise::Piecewise2D;
 use crate::sampler::warp::uniform_sphere;
 use crate::scene::check::Check;
-use crate::scene::desc::EnvironmentDesc;
+use crate::scene::desc::{EnvMapping, EnvironmentDesc};
 
 mod map;
 mod sky;
 #[cfg(test)]
 mod tests;
 
-use map::{CACHED_TEXELS, EnvMap, fit_texels, from_uv, to_uv};
+use map::{CACHED_TEXELS, EnvMap, fit_texels, from_square, from_uv, to_square, to_uv};
 use sky::SkyEnv;
 
 /// The most texels an environment map may have (a 8192 x 4096 map): each
@@ -110,13 +121,28 @@ impl EnvironmentLight {
         }
     }
 
-    /// A map of `width` x `height` linear sRGB texels (row 0 at the top),
-    /// scaled by `scale`, turned by `rotation` (world from map). Errors (as
-    /// plain messages: the caller names the field) for an empty or too large
+    /// An equirectangular map of `width` x `height` linear sRGB texels (row 0 at
+    /// the top), scaled by `scale`, turned by `rotation` (world from map). Errors
+    /// (as plain messages: the caller names the field) for an empty or too large
     /// map, a negative or non-finite texel, or a map that is black everywhere.
     pub fn map(width: usize, height: usize, rgb: &[[f32; 3]], scale: f32, rotation: Mat3) -> Result<Self, String> {
+        Self::map_with(width, height, rgb, scale, rotation, EnvMapping::Equirectangular)
+    }
+
+    /// [`EnvironmentLight::map`] with the given `mapping` (an equal-area map must be square).
+    pub fn map_with(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        scale: f32,
+        rotation: Mat3,
+        mapping: EnvMapping,
+    ) -> Result<Self, String> {
         if width == 0 || height == 0 || rgb.len() != width * height {
             return Err(format!("expected a non-empty image, found {width}x{height}"));
+        }
+        if mapping == EnvMapping::EqualArea && width != height {
+            return Err(format!("an equal-area map is square; this one is {width}x{height}"));
         }
         if width * height > MAX_MAP_TEXELS {
             return Err(format!(
@@ -141,8 +167,13 @@ impl EnvironmentLight {
         let mut peak = Spectrum::ZERO;
         let mut integral = 0.0f64;
         for j in 0..height {
-            let (t0, t1) = (PI * j as f32 / height as f32, PI * (j + 1) as f32 / height as f32);
-            let solid = (2.0 * PI / width as f32) * (t0.cos() - t1.cos());
+            let solid = match mapping {
+                EnvMapping::Equirectangular => {
+                    let (t0, t1) = (PI * j as f32 / height as f32, PI * (j + 1) as f32 / height as f32);
+                    (2.0 * PI / width as f32) * (t0.cos() - t1.cos())
+                }
+                EnvMapping::EqualArea => 4.0 * PI / (width * height) as f32,
+            };
             for i in 0..width {
                 let k = j * width + i;
                 integral += (mean[k] * solid) as f64;
@@ -155,31 +186,41 @@ impl EnvironmentLight {
         if !(integral > 0.0 && integral.is_finite()) {
             return Err("the map is black everywhere (or its total is not finite): it emits nothing".into());
         }
-        // Sampling weights: the 3x3 neighbourhood's mean, times sin θ of the row.
+        // Sampling weights: the 3x3 neighbourhood's mean (across the map's edges as
+        // the bilinear lookup goes), times the row's sin θ for an equirectangular map
+        // (an equal-area map's texels all span the same solid angle).
+        let mut env = EnvMap {
+            width,
+            height,
+            mapping,
+            texels,
+            spectra: Vec::new(),
+            dist: Piecewise2D::new(&[1.0], 1, 1).expect("one cell"),
+            d65,
+        };
         let mut weights = vec![0.0f32; width * height];
         for j in 0..height {
-            let sin = (PI * (j as f32 + 0.5) / height as f32).sin();
+            let sin = match mapping {
+                EnvMapping::Equirectangular => (PI * (j as f32 + 0.5) / height as f32).sin(),
+                EnvMapping::EqualArea => 1.0,
+            };
             for i in 0..width {
                 let mut sum = 0.0f32;
                 for dj in -1i64..=1 {
-                    let jj = (j as i64 + dj).clamp(0, height as i64 - 1) as usize;
                     for di in -1i64..=1 {
-                        let ii = (i as i64 + di).rem_euclid(width as i64) as usize;
-                        sum += mean[jj * width + ii];
+                        sum += mean[env.texel_index(i as i64 + di, j as i64 + dj)];
                     }
                 }
                 weights[j * width + i] = sum / 9.0 * sin;
             }
         }
-        let dist = Piecewise2D::new(&weights, width, height)
+        env.dist = Piecewise2D::new(&weights, width, height)
             .ok_or_else(|| "the map's sampling density is zero or not finite".to_string())?;
-        let spectra = if texels.len() <= CACHED_TEXELS {
-            texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &d65)).collect()
-        } else {
-            Vec::new()
-        };
+        if env.texels.len() <= CACHED_TEXELS {
+            env.spectra = env.texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &d65)).collect();
+        }
         Ok(EnvironmentLight {
-            source: Source::Map(Box::new(EnvMap { width, height, texels, spectra, dist, d65 })),
+            source: Source::Map(Box::new(env)),
             to_map: rotation.transpose(),
             from_map: rotation,
             peak,
@@ -193,7 +234,7 @@ impl EnvironmentLight {
     pub fn radiance(&self, wi: Vec3) -> Spectrum {
         match &self.source {
             Source::Uniform(s) => *s,
-            Source::Map(m) => m.radiance(to_uv(self.to_map * wi)),
+            Source::Map(m) => m.radiance(m.uv_of(self.to_map * wi)),
             Source::Sky(sky) => sky.radiance(wi),
         }
     }
@@ -217,6 +258,9 @@ impl EnvironmentLight {
     pub fn pdf_li(&self, wi: Vec3) -> f32 {
         match &self.source {
             Source::Uniform(_) => 1.0 / (4.0 * PI),
+            Source::Map(m) if m.mapping == EnvMapping::EqualArea => {
+                m.dist.pdf(to_square(self.to_map * wi)) / (4.0 * PI)
+            }
             Source::Map(m) => {
                 let mm = self.to_map * wi;
                 // sin θ from x and z: accurate near the poles, where 1 − y² is not.
@@ -235,6 +279,11 @@ impl EnvironmentLight {
     fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32)> {
         match &self.source {
             Source::Uniform(_) => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
+            Source::Map(m) if m.mapping == EnvMapping::EqualArea => {
+                let (uv, pdf_uv) = m.dist.sample(u);
+                let pdf = pdf_uv / (4.0 * PI);
+                (pdf.is_finite() && pdf > 0.0).then(|| ((self.from_map * from_square(uv)).normalize(), pdf))
+            }
             Source::Map(m) => {
                 let (uv, pdf_uv) = m.dist.sample(u);
                 let (mm, sin) = from_uv(uv);
@@ -274,7 +323,7 @@ impl EnvironmentLight {
                 }
                 Ok(EnvironmentLight::uniform(s))
             }
-            EnvironmentDesc::Image { path, scale, rotate_deg } => {
+            EnvironmentDesc::Image { path, scale, rotate_deg, mapping } => {
                 let field = format!("{FIELD}.path");
                 let scale = check.positive(&format!("{FIELD}.scale"), *scale)?;
                 let rotation = Transform {
@@ -285,7 +334,7 @@ impl EnvironmentLight {
                 let (resolved, bytes) = check.read_input(&field, path)?;
                 let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&field, e.to_string()))?;
                 let rgb = pixels.linear_rgb();
-                EnvironmentLight::map(w as usize, h as usize, &rgb, scale, rotation)
+                EnvironmentLight::map_with(w as usize, h as usize, &rgb, scale, rotation, *mapping)
                     .map_err(|m| check.err(&field, format!("{path}: {m}")))
             }
             EnvironmentDesc::Sky { sun_elevation_deg, sun_azimuth_deg, turbidity, ground_albedo, scale } => {

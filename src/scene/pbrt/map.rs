@@ -16,12 +16,14 @@ use super::parser::{Loc, Param, Params, Parser, Value};
 use crate::error::Result;
 use crate::io::{MeshData, fnv1a, parse_mesh, read_input};
 use crate::scene::desc::{
-    CameraDesc, EnvironmentDesc, IorDesc, LightDesc, MaterialDesc, ObjectDesc, ShapeDesc, SpectrumDesc, V3, Wrap,
+    CameraDesc, EnvironmentDesc, IorDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, PhaseDesc, ShapeDesc,
+    SpectrumDesc, V3, Wrap,
 };
 use crate::settings::{IntegratorKind, SettingsPatch};
 
 mod lights;
 mod materials;
+mod media;
 mod options;
 mod shapes;
 
@@ -77,6 +79,9 @@ pub(crate) struct ShapeRec {
     pub(crate) reverse: bool,
     pub(crate) material: MatRef,
     pub(crate) area: Option<AreaLight>,
+    /// The `MediumInterface` names (empty: vacuum).
+    pub(crate) inside: String,
+    pub(crate) outside: String,
     pub(crate) loc: Loc,
 }
 
@@ -104,8 +109,12 @@ pub(crate) struct Built {
     pub(crate) objects: Vec<ObjectDesc>,
     /// Per object: the PLY file (as written in the scene) its triangles came from.
     pub(crate) mesh_files: Vec<Option<String>>,
+    /// Per object: where its `Shape` is.
+    pub(crate) object_locs: Vec<Loc>,
     pub(crate) lights: Vec<LightDesc>,
     pub(crate) environment: Option<EnvironmentDesc>,
+    /// Where the environment comes from (the map's `filename`, or the `LightSource`).
+    pub(crate) environment_loc: Option<Loc>,
     pub(crate) camera: Option<CameraDesc>,
     pending_camera: Option<PendingCamera>,
     pub(crate) render: SettingsPatch,
@@ -113,6 +122,16 @@ pub(crate) struct Built {
     /// `M`: world space to rust-v's (identity or a mirror).
     pub(crate) mirror: DMat4,
     pending: Vec<PendingPly>,
+    /// `MakeNamedMedium`s as read, in order, resolved into `media` after parsing.
+    named_media: Vec<media::Named>,
+    /// The media of the description (see [`Parser::resolve_media`]).
+    pub(crate) media: Vec<(String, MediumDesc)>,
+    /// Objects with an interior medium: the object, the medium's name and the shape's place.
+    interiors: Vec<(usize, String, Loc)>,
+    /// Objects with an outside medium, as `interiors`.
+    exteriors: Vec<(usize, String, Loc)>,
+    /// The outside medium at the `Camera` directive and its place.
+    pub(crate) camera_medium: Option<(String, Loc)>,
     anonymous: usize,
     /// Triangles placed so far (copies of instances included), against [`MAX_TRIANGLES`].
     triangles: usize,
@@ -131,8 +150,10 @@ impl Default for Built {
             textures: HashMap::new(),
             objects: Vec::new(),
             mesh_files: Vec::new(),
+            object_locs: Vec::new(),
             lights: Vec::new(),
             environment: None,
+            environment_loc: None,
             camera: None,
             pending_camera: None,
             // pbrt-v4's defaults when a directive is left out: a 1280x720 film, 16 samples
@@ -148,6 +169,11 @@ impl Default for Built {
             resolution: (1280, 720),
             mirror: DMat4::IDENTITY,
             pending: Vec::new(),
+            named_media: Vec::new(),
+            media: Vec::new(),
+            interiors: Vec::new(),
+            exteriors: Vec::new(),
+            camera_medium: None,
             anonymous: 0,
             triangles: 0,
         }

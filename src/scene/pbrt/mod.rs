@@ -15,9 +15,9 @@ mod map;
 mod parser;
 mod write;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::scene::check::Check;
 use crate::scene::desc::{NamedMap, SceneDesc};
 
@@ -31,6 +31,45 @@ pub(crate) struct Imported {
     pub(crate) warnings: Vec<String>,
     /// Per object: the PLY file its triangles came from, if any.
     pub(crate) mesh_files: Vec<Option<String>>,
+    /// Where the description's objects and environment come from (see [`locate`]).
+    pub(crate) places: Places,
+}
+
+/// A file, line and column.
+type Place = (PathBuf, usize, usize);
+
+/// Where parts of an imported description come from.
+#[derive(Default)]
+pub(crate) struct Places {
+    /// Per object: its `Shape` directive.
+    objects: Vec<Place>,
+    /// The infinite light's `LightSource` (its `filename` for a map).
+    environment: Option<Place>,
+}
+
+/// An error of the scene built from a pbrt file about `objects[i]` (an `exterior:`
+/// that disagrees with the volumes around the shape, a grid medium under `whitted`)
+/// or about the `environment` (a map that is not square, black or unreadable),
+/// moved to the directive it came from, the field kept in the message; any other
+/// error as it is.
+pub(crate) fn locate(places: &Places, e: Error) -> Error {
+    let Error::Scene { path, position: None, field, message } = e else { return e };
+    let index =
+        field.strip_prefix("objects[").and_then(|r| r.split_once(']')).and_then(|(i, _)| i.parse::<usize>().ok());
+    let place = match index {
+        Some(i) => places.objects.get(i),
+        None if field.starts_with("environment") => places.environment.as_ref(),
+        None => None,
+    };
+    match place {
+        Some((file, line, col)) => Error::Scene {
+            path: file.clone(),
+            position: Some((*line, *col)),
+            field: String::new(),
+            message: format!("{field} (from here): {message}"),
+        },
+        None => Error::Scene { path, position: None, field, message },
+    }
 }
 
 /// Whether `path` names a pbrt scene (`.pbrt`, any case).
@@ -61,20 +100,27 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
     let mut p = parser::Parser::new(ctx, path, text.to_string(), strict);
     p.run()?;
     p.resolve_plys()?;
+    p.resolve_media()?;
     let warnings = p.warning_lines();
     let b = std::mem::take(&mut p.built);
     let camera = b.camera.ok_or_else(|| crate::error::Error::scene_field(path, "", "the file has no WorldBegin"))?;
+    let place = |l: &parser::Loc| (p.files[l.file].clone(), l.line, l.col);
+    let places = Places {
+        objects: b.object_locs.iter().map(place).collect(),
+        environment: b.environment_loc.as_ref().map(place),
+    };
     Ok(Imported {
         desc: SceneDesc {
             camera,
             render: b.render,
             materials: NamedMap(b.materials),
-            media: NamedMap(Vec::new()),
+            media: NamedMap(b.media),
             objects: b.objects,
             lights: b.lights,
             environment: b.environment,
         },
         warnings,
         mesh_files: b.mesh_files,
+        places,
     })
 }

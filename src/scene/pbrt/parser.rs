@@ -78,6 +78,10 @@ pub(crate) struct State {
     pub(crate) reverse: bool,
     pub(crate) material: MatRef,
     pub(crate) area: Option<AreaLight>,
+    /// `MediumInterface`: the medium inside shapes and the one outside (and
+    /// around the camera), by name; empty for vacuum.
+    pub(crate) inside: String,
+    pub(crate) outside: String,
 }
 
 /// Collected warnings: each distinct message once, with its first place and how
@@ -122,7 +126,14 @@ impl<'c> Parser<'c> {
             stack: vec![Open { lexer: Lexer::new(text), file: 0 }],
             peeked: None,
             warnings: Warnings::default(),
-            state: State { ctm: DMat4::IDENTITY, reverse: false, material: MatRef::Default, area: None },
+            state: State {
+                ctm: DMat4::IDENTITY,
+                reverse: false,
+                material: MatRef::Default,
+                area: None,
+                inside: String::new(),
+                outside: String::new(),
+            },
             saved: Vec::new(),
             named_cs: HashMap::new(),
             world: false,

@@ -169,14 +169,14 @@ fn rebase(s: &mut SpectrumDesc, from: &Path, to: &Path) {
 }
 
 /// Converts the pbrt scene `scene` to the RON scene `output` (and its mesh files);
-/// returns the import's warnings and the mesh files written.
+/// returns the import's warnings and the files written beside it (meshes, grids, maps).
 pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>, Vec<PathBuf>)> {
     let bytes = read_input(scene)?;
     let text = std::str::from_utf8(bytes.strip_prefix(&[0xef, 0xbb, 0xbf]).unwrap_or(&bytes)).map_err(|e| {
         Error::scene_field(scene, "", format!("byte {} is not UTF-8; expected UTF-8 text", e.valid_up_to()))
     })?;
     let ctx = Check::new(scene);
-    let Imported { mut desc, warnings, mesh_files } = super::import(&ctx, scene, text, strict)?;
+    let Imported { mut desc, warnings, mesh_files, .. } = super::import(&ctx, scene, text, strict)?;
     let out_dir = crate::io::parent_dir(output).to_path_buf();
     let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     let mut written = Vec::new();
@@ -196,6 +196,29 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         write_atomic(&path, &ply_bytes(&mesh))?;
         written.push(path);
         o.shape = ShapeDesc::Mesh { path: name, scale: None, rotate_deg: None, translate: None };
+    }
+    // A `uniformgrid`'s density, made in memory by the import, as a file beside the output.
+    for (k, (_, m)) in desc.media.0.iter_mut().filter(|(_, m)| matches!(m, MediumDesc::Grid { .. })).enumerate() {
+        let MediumDesc::Grid { path, .. } = m else { continue };
+        let Some(bytes) = ctx.provided(path) else { continue };
+        let name = format!("{stem}-medium-{k}.vol");
+        let at = out_dir.join(&name);
+        write_atomic(&at, &bytes)?;
+        written.push(at);
+        *path = name;
+    }
+    if let Some(EnvironmentDesc::Image { path, .. }) = desc.environment.as_mut() {
+        match ctx.provided(path) {
+            // A map the import flipped in memory (see `map/lights.rs`).
+            Some(bytes) => {
+                let name = format!("{stem}-envmap.exr");
+                let at = out_dir.join(&name);
+                write_atomic(&at, &bytes)?;
+                written.push(at);
+                *path = name;
+            }
+            None => *path = relative(&ctx.dir.join(&*path), &out_dir),
+        }
     }
     for (_, m) in desc.materials.0.iter_mut() {
         use crate::scene::desc::MaterialDesc as M;

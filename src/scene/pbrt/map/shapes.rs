@@ -105,10 +105,28 @@ impl Parser<'_> {
             MatRef::Name(n) => Some(n.clone()),
             MatRef::Default => Some(self.default_material()),
             MatRef::Interface if rec.area.is_some() => None,
+            // A boundary between two media (vacuum inside: a clear volume).
+            MatRef::Interface if rec.inside != rec.outside => Some(self.interface_material()),
             MatRef::Interface => {
-                self.warn(at, "a shape with the interface material (a medium's boundary) is left out")?;
+                self.warn(at, "a shape with the interface material and the same medium on both sides is left out")?;
                 return Ok(());
             }
+        };
+        let bounds_volume = material.as_ref().is_some_and(|n| {
+            self.built
+                .materials
+                .iter()
+                .any(|(k, m)| k == n && matches!(m, MaterialDesc::Dielectric { .. } | MaterialDesc::Interface))
+        });
+        // pbrt's inside is the side its normal points away from: a sphere that pbrt turns
+        // inside out has its "inside" medium around it (rust-v's spheres face outwards).
+        let inside_out = rec.ty == "sphere" && quadric_flip && (!rec.inside.is_empty() || !rec.outside.is_empty());
+        let (interior, exterior) = if inside_out {
+            self.note(at, "MediumInterface on a sphere that pbrt turns inside out (ReverseOrientation, or a mirroring transform): its \"inside\" medium is around it and its \"outside\" medium within it");
+            let swapped = ShapeRec { inside: rec.outside.clone(), outside: rec.inside.clone(), ..rec.clone() };
+            self.media_of(&swapped, bounds_volume)
+        } else {
+            self.media_of(rec, bounds_volume)
         };
         let emission = rec.area.as_ref().map(|a| a.emission(area));
         let two_sided = rec.area.as_ref().is_some_and(|a| a.two_sided);
@@ -124,6 +142,12 @@ impl Parser<'_> {
                 area: rec.area.clone(),
             });
         }
+        if let Some(name) = interior {
+            self.built.interiors.push((self.built.objects.len(), name, at));
+        }
+        if let Some(name) = exterior {
+            self.built.exteriors.push((self.built.objects.len(), name, at));
+        }
         self.built.objects.push(ObjectDesc {
             shape,
             material,
@@ -135,6 +159,7 @@ impl Parser<'_> {
             exterior: None,
         });
         self.built.mesh_files.push(mesh_file);
+        self.built.object_locs.push(at);
         Ok(())
     }
 
@@ -200,6 +225,15 @@ impl Parser<'_> {
             }
         }
         Ok(())
+    }
+
+    /// The index-matched boundary of a medium (pbrt's `interface` material).
+    pub(super) fn interface_material(&mut self) -> String {
+        let name = "pbrt-interface".to_string();
+        if !self.built.materials.iter().any(|(k, _)| *k == name) {
+            self.built.materials.push((name.clone(), MaterialDesc::Interface));
+        }
+        name
     }
 
     pub(super) fn default_material(&mut self) -> String {

@@ -190,6 +190,8 @@ impl Parser<'_> {
                 match word {
                     "Camera" => {
                         self.named_cs.insert("camera".into(), self.state.ctm.inverse());
+                        // pbrt-v4: the camera sits in the outside medium of the current MediumInterface.
+                        self.built.camera_medium = Some((self.state.outside.clone(), at));
                         self.camera(&ty, at, &ps, self.state.ctm)?;
                     }
                     "Film" => self.film(&ty, at, &ps)?,
@@ -207,18 +209,18 @@ impl Parser<'_> {
             }
             "MakeNamedMedium" => {
                 let (name, at) = self.string_arg(loc, "a medium's name")?;
-                self.params()?;
-                self.warn(
-                    at,
-                    format!("MakeNamedMedium \"{name}\": participating media are not supported yet (ignored)"),
-                )?;
+                let ps = self.params()?;
+                self.make_medium(name, at, &ps)?;
             }
             "MediumInterface" => {
-                let (_, at) = self.string_arg(loc, "a medium's name")?;
-                if let Some(Tok::Str(_)) = self.peek()? {
-                    self.next()?;
-                }
-                self.warn(at, "MediumInterface: participating media are not supported yet (ignored)")?;
+                let (inside, at) = self.string_arg(loc, "a medium's name")?;
+                // pbrt-v4: one name is both the inside and the outside.
+                let outside = match self.peek()? {
+                    Some(Tok::Str(_)) => self.string_arg(at, "a medium's name")?.0,
+                    _ => inside.clone(),
+                };
+                self.state.inside = inside;
+                self.state.outside = outside;
             }
             "Shape" | "Material" | "MakeNamedMaterial" | "NamedMaterial" | "Texture" | "LightSource"
             | "AreaLightSource" | "ObjectBegin" | "ObjectEnd" | "ObjectInstance" => {
@@ -250,6 +252,8 @@ impl Parser<'_> {
                     reverse: self.state.reverse,
                     material: self.state.material.clone(),
                     area: self.state.area.clone(),
+                    inside: self.state.inside.clone(),
+                    outside: self.state.outside.clone(),
                     loc: at,
                 };
                 match &mut self.object {
