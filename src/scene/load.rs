@@ -298,7 +298,8 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         let eye = ctx.vec("camera.eye", desc.camera.eye)?;
         materials.push(Bxdf::Interface);
         textures.push(None);
-        objects.push(surround::world_volume(ctx, &objects, eye, m, materials.len() as u32 - 1)?);
+        let aperture = if desc.camera.aperture_radius.is_finite() { desc.camera.aperture_radius.max(0.0) } else { 0.0 };
+        objects.push(surround::world_volume(ctx, &objects, (eye, aperture), m, materials.len() as u32 - 1)?);
         names.push(Some(name.as_str()));
     }
     let known: Vec<&str> = media.keys().copied().collect();

@@ -47,25 +47,28 @@ use crate::shape::{Shape, Sphere};
 pub const WORLD_MARGIN: f32 = 1.05;
 
 /// The sphere the camera's medium fills: around the bounds of every bounded
-/// object and the eye, radius `WORLD_MARGIN` times the half-diagonal (at
-/// least 1e-3 scene units).
-pub fn world_sphere(objects: &[Object], eye: Vec3) -> (Vec3, f32) {
-    let world = objects.iter().filter_map(|o| o.shape.bounds()).fold(Aabb::new(eye, eye), |a, b| a.union(&b));
+/// object and the camera (the eye and, for a thin lens, a cube of the
+/// aperture's radius around it), radius `WORLD_MARGIN` times the
+/// half-diagonal (at least 1e-3 scene units).
+pub fn world_sphere(objects: &[Object], eye: Vec3, aperture: f32) -> (Vec3, f32) {
+    let camera = Aabb::new(eye - Vec3::splat(aperture), eye + Vec3::splat(aperture));
+    let world = objects.iter().filter_map(|o| o.shape.bounds()).fold(camera, |a, b| a.union(&b));
     let center = world.centroid();
     let radius = (world.diagonal().length() * 0.5 * WORLD_MARGIN).max(1e-3);
     (center, radius)
 }
 
 /// The object that holds the camera's medium `medium`: an index-matched
-/// sphere (material `interface`, an `Interface`) around the scene and `eye`.
+/// sphere (material `interface`, an `Interface`) around the scene and the
+/// camera at `eye` with a thin lens of radius `aperture`.
 pub(crate) fn world_volume(
     ctx: &Check<'_>,
     objects: &[Object],
-    eye: Vec3,
+    (eye, aperture): (Vec3, f32),
     medium: &Medium,
     interface: u32,
 ) -> Result<Object> {
-    let (center, radius) = world_sphere(objects, eye);
+    let (center, radius) = world_sphere(objects, eye, aperture);
     if !(center.is_finite() && radius.is_finite()) {
         return Err(ctx.err("camera.medium", "the scene's bounds are not finite: no sphere can hold the medium"));
     }
