@@ -287,9 +287,12 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
 /// medium, where a narrow beam's single scattering reaches a camera path
 /// only when its distance sample lands in the beam (light subpaths start in
 /// it: on `milky-water.ron` BDPT's error at equal time is a third of path
-/// tracing's or less). `auto` then picks `bdpt`.
+/// tracing's or less). The sky's sun, half a degree across, counts as a
+/// delta light for caustics (a camera path reaches it through smooth glass
+/// only by hitting its disk). `auto` then picks `bdpt`.
 pub fn needs_bdpt(scene: &Scene) -> bool {
-    scene.has_delta_light() && (scene.has_delta_surface() || scene.has_scattering())
+    let caustics = scene.has_delta_surface() && (scene.has_delta_light() || scene.has_sun());
+    caustics || (scene.has_delta_light() && scene.has_scattering())
 }
 
 /// One line saying which light-transport model the settings pick for this
@@ -325,11 +328,11 @@ fn describe_transport(scene: &Scene) -> String {
     let dispersive = scene.has_dispersion();
     match s.integrator {
         IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => format!(
-            "auto: a point, spot, distant or beam light meets {}: bidirectional path tracing{}",
-            if scene.has_delta_surface() {
-                "a specular surface (caustics path tracing cannot find)"
-            } else {
-                "a scattering medium (light subpaths start in its beam)"
+            "auto: {}: bidirectional path tracing{}",
+            match (scene.has_delta_surface(), scene.has_delta_light()) {
+                (true, true) => "a point, spot, distant or beam light meets a specular surface (caustics path tracing cannot find)",
+                (true, false) => "the sky's sun meets a specular surface (caustics path tracing cannot find)",
+                _ => "a point, spot, distant or beam light meets a scattering medium (light subpaths start in its beam)",
             },
             if dispersive { "; the full spectrum until a subpath refracts at dispersive glass, then one wavelength" } else { ", full spectrum" }
         ),
@@ -558,6 +561,43 @@ pub(crate) fn sample_direct_medium<const N: usize>(
 mod tests {
     use super::*;
     use crate::settings::SettingsPatch;
+
+    /// What `auto` picks, and the reason it prints: BDPT for a spot on glass, a spot in a scattering medium, and the
+    /// sky's sun on glass; path tracing for an index-matched boundary under
+    /// a spot, and for a uniform environment over glass.
+    #[test]
+    fn auto_picks_bdpt_where_path_tracing_cannot_reach_the_light() {
+        let scene = |materials: &str, light: &str, media: &str, interior: &str| {
+            let text = format!(
+                r#"(camera: (eye: (0, 0, 5), look_at: (0, 0, 0), fov_deg: 30),
+                media: {{ {media} }},
+                materials: {{ "m": {materials}, "floor": Lambertian(reflectance: Constant(0.5)) }},
+                objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m"{interior}),
+                           (shape: Quad(origin: (-3, -1, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor") ],
+                {light})"#
+            );
+            crate::scene::load_scene_str(&text, std::path::Path::new("t.ron"), &SettingsPatch::default()).unwrap()
+        };
+        let spot = "lights: [ Spot(position: (0, 3, 0), look_at: (0, 0, 0), cone_deg: 20, falloff_deg: 5, intensity: Constant(5)) ]";
+        let sky = "environment: Sky(sun_elevation_deg: 30, sun_azimuth_deg: 0, turbidity: 3, ground_albedo: 0.3)";
+        let milk = r#""milk": Homogeneous(sigma_a: Constant(0.1), sigma_s: Constant(1))"#;
+        let glass = "Dielectric(ior: Constant(1.5))";
+        let cases = [
+            (scene(glass, spot, "", ""), Some("specular surface")),
+            (scene("Interface", spot, milk, r#", interior: "milk""#), Some("scattering medium")),
+            (scene(glass, sky, "", ""), Some("the sky's sun")),
+            (scene("Interface", spot, "", ""), None),
+            (scene(glass, "environment: Uniform(Constant(1))", "", ""), None),
+            (scene("Interface", sky, milk, r#", interior: "milk""#), None),
+        ];
+        for (i, (s, want)) in cases.iter().enumerate() {
+            let line = describe(s);
+            assert_eq!(needs_bdpt(s), want.is_some(), "case {i}: {line}");
+            if let Some(w) = want {
+                assert!(line.contains(w) && line.contains("bidirectional"), "case {i}: {line}");
+            }
+        }
+    }
 
     /// Water (1.33) in glass (1.5): the interface the medium stack finds
     /// refracts by Snell's law with both absolute indices, n_glass sin θ_g =

@@ -228,6 +228,11 @@ impl Scene {
         self.scattering
     }
 
+    /// True when the environment is the sky with its sun (a near-delta light).
+    pub fn has_sun(&self) -> bool {
+        self.environment.is_some_and(|i| matches!(&self.lights[i as usize], Light::Environment(e) if e.has_sun()))
+    }
+
     /// True when the scene has an environment.
     #[inline]
     pub fn has_environment(&self) -> bool {

@@ -108,6 +108,13 @@ enum Source {
 }
 
 impl EnvironmentLight {
+    /// True for the Hosek-Wilkie sky, whose sun (half a degree across) lights
+    /// the scene almost as a delta light does: caustics of it are found by
+    /// light subpaths, hardly by camera paths.
+    pub fn has_sun(&self) -> bool {
+        matches!(self.source, Source::Sky(_))
+    }
+
     /// Radiance `spectrum` from every direction.
     pub fn uniform(spectrum: Spectrum) -> EnvironmentLight {
         EnvironmentLight {
