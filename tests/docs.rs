@@ -23,7 +23,7 @@
 //! the test with the block's line in the page and the loader's error.
 //!
 //! **In step with `desc.rs`.** Every variant of the scene format's enums and every field
-//! name in `src/scene/desc.rs` (and every render setting of `src/settings.rs`) must appear
+//! name in `src/scene/desc.rs` and `src/scene/desc/` (and every render setting of `src/settings.rs`) must appear
 //! in a `ron` block of the page.
 //!
 //! **Links.** Every relative link in `README.md`, `docs/*.md` and `tests/README.md` must
@@ -253,7 +253,15 @@ fn scene_format_covers_every_variant_and_field_of_desc() {
     let words: BTreeSet<String> =
         ron.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).map(str::to_string).collect();
     // ScaleDesc is untagged: its variants are never written (`scale: 0.5` or `(x, y, z)`).
-    let (variants, fields) = desc_names(&read(&root().join("src/scene/desc.rs")), &["ScaleDesc"]);
+    // desc.rs and its parts in src/scene/desc/, in name order.
+    let mut parts: Vec<_> = std::fs::read_dir(root().join("src/scene/desc"))
+        .expect("src/scene/desc/")
+        .map(|e| e.expect("a file of src/scene/desc/").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "rs"))
+        .collect();
+    parts.sort();
+    let desc = std::iter::once(root().join("src/scene/desc.rs")).chain(parts).map(|p| read(&p)).collect::<Vec<_>>();
+    let (variants, fields) = desc_names(&desc.join("\n"), &["ScaleDesc"]);
     assert!(variants.len() >= 30 && fields.len() >= 30, "desc.rs parsed badly: {variants:?} {fields:?}");
     let settings_src = read(&root().join("src/settings.rs"));
     let start = settings_src.find("\nsettings! {").expect("the settings! invocation in src/settings.rs");

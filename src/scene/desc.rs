@@ -28,6 +28,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::settings::SettingsPatch;
 
+mod camera;
+mod surroundings;
+
+pub use camera::{CameraDesc, LensDesc};
+pub use surroundings::{EnvMapping, EnvironmentDesc, MediumDesc, PhaseDesc};
+
 /// A 3-vector in the file: `(x, y, z)`.
 pub type V3 = [f32; 3];
 
@@ -58,76 +64,7 @@ pub struct SceneDesc {
     pub environment: Option<EnvironmentDesc>,
 }
 
-/// The scene's `environment:`.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub enum EnvironmentDesc {
-    /// The same radiance from every direction: `Uniform(Constant(1))`.
-    Uniform(SpectrumDesc),
-    /// An environment map (PNG, sRGB-decoded, or EXR, linear), +y up:
-    /// `Image(path: "sky.exr", scale: 1, rotate_deg: (0, 90, 0))`, equirectangular
-    /// unless `mapping: EqualArea` (pbrt-v4's square maps).
-    Image {
-        /// The image file, relative to the scene file.
-        path: String,
-        /// A factor on every texel (default 1).
-        #[serde(default = "one")]
-        scale: f32,
-        /// Turns the map about X, then Y, then Z, in degrees (default none).
-        #[serde(default)]
-        rotate_deg: V3,
-        /// How the image covers the sphere (default `Equirectangular`).
-        #[serde(default, skip_serializing_if = "EnvMapping::is_equirectangular")]
-        mapping: EnvMapping,
-    },
-    /// The spectral Hosek-Wilkie sky with its sun, in absolute units
-    /// (W m⁻² sr⁻¹ nm⁻¹): `Sky(sun_elevation_deg: 20, sun_azimuth_deg: 30, turbidity: 3, ground_albedo: 0.3)`.
-    Sky {
-        /// The sun's height above the horizon, degrees in [0, 90].
-        sun_elevation_deg: f32,
-        /// The sun's direction about +y, degrees: 0 towards −z, 90 towards +x (default 0).
-        #[serde(default)]
-        sun_azimuth_deg: f32,
-        /// Atmospheric turbidity in [1, 10] (default 3: a clear day).
-        #[serde(default = "default_turbidity")]
-        turbidity: f32,
-        /// The ground's reflectance in [0, 1] (default 0.3).
-        #[serde(default = "default_ground_albedo")]
-        ground_albedo: f32,
-        /// A factor on the sky, sun and ground (default 1).
-        #[serde(default = "one")]
-        scale: f32,
-    },
-}
-
-/// How an environment `Image` covers the sphere of directions
-/// (`crate::light::EnvironmentLight`'s module docs give the orientations).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
-pub enum EnvMapping {
-    /// Latitude-longitude: rows from +y down to −y, u around +y (the default).
-    #[default]
-    Equirectangular,
-    /// The equal-area octahedral square (Clarberg 2008) of pbrt-v4's image
-    /// infinite lights: a square image, every texel the same solid angle, its
-    /// centre looking up (+y), its corners down.
-    EqualArea,
-}
-
-impl EnvMapping {
-    fn is_equirectangular(&self) -> bool {
-        *self == EnvMapping::Equirectangular
-    }
-}
-
-fn default_turbidity() -> f32 {
-    3.0
-}
-
-fn default_ground_albedo() -> f32 {
-    0.3
-}
-
-fn one() -> f32 {
+pub(super) fn one() -> f32 {
     1.0
 }
 
@@ -135,7 +72,7 @@ fn is_zero(v: &u32) -> bool {
     *v == 0
 }
 
-fn is_zero_f32(v: &f32) -> bool {
+pub(super) fn is_zero_f32(v: &f32) -> bool {
     *v == 0.0
 }
 
@@ -201,112 +138,6 @@ impl<'de, T: Deserialize<'de> + Noun> Deserialize<'de> for NamedMap<T> {
         }
         d.deserialize_map(Visit(std::marker::PhantomData))
     }
-}
-
-/// A participating medium (`crate::medium`): coefficients per scene unit.
-#[derive(Clone, Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub enum MediumDesc {
-    /// The same everywhere:
-    /// `Homogeneous(sigma_a: Constant(0.01), sigma_s: Rayleigh(0.5), phase: Isotropic)`.
-    Homogeneous {
-        /// Absorption coefficient per scene unit.
-        sigma_a: SpectrumDesc,
-        /// Scattering coefficient per scene unit.
-        sigma_s: SpectrumDesc,
-        /// The phase function (default `Isotropic`).
-        #[serde(default)]
-        phase: PhaseDesc,
-    },
-    /// A density on a voxel grid (Mitsuba's `.vol`, 32-bit floats, one channel)
-    /// filling the object's bounding box, times the coefficients:
-    /// `Grid(path: "smoke.vol", sigma_a: Constant(0.5), sigma_s: Constant(4), density_scale: 1, phase: Isotropic)`.
-    Grid {
-        /// The `.vol` file, relative to the scene file.
-        path: String,
-        /// Absorption coefficient per scene unit at density 1.
-        sigma_a: SpectrumDesc,
-        /// Scattering coefficient per scene unit at density 1.
-        sigma_s: SpectrumDesc,
-        /// A factor on the density (default 1).
-        #[serde(default = "one")]
-        density_scale: f32,
-        /// The phase function (default `Isotropic`).
-        #[serde(default)]
-        phase: PhaseDesc,
-    },
-}
-
-/// A medium's phase function.
-#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub enum PhaseDesc {
-    /// The same in every direction (the default).
-    #[default]
-    Isotropic,
-    /// Henyey-Greenstein of mean cosine `g` in [−0.999, 0.999] (> 0 forward):
-    /// `HenyeyGreenstein(g: 0.7)`.
-    HenyeyGreenstein {
-        /// The mean cosine of the scattering angle.
-        g: f32,
-    },
-}
-
-/// A pinhole camera, a thin lens with depth of field, or a lens system.
-#[derive(Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct CameraDesc {
-    /// Position of the eye.
-    pub eye: V3,
-    /// The point looked at.
-    pub look_at: V3,
-    /// The up direction (default `(0, 1, 0)`).
-    #[serde(default = "default_up")]
-    pub up: V3,
-    /// Vertical field of view in degrees (required, except with a `lens`,
-    /// whose focal length and film set it).
-    #[serde(default)]
-    pub fov_deg: Option<f32>,
-    /// The thin lens's radius in scene units (default 0: a pinhole, no depth of field).
-    #[serde(default, skip_serializing_if = "is_zero_f32")]
-    pub aperture_radius: f32,
-    /// The distance of the plane in focus along the view direction (default:
-    /// from `eye` to `look_at`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub focus_distance: Option<f32>,
-    /// A lens system in front of a film, instead of the pinhole or thin lens.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lens: Option<LensDesc>,
-    /// The name of a medium in `media` that the camera sits in: it fills the
-    /// space around the scene, out to a sphere enclosing every bounded object
-    /// and the eye (vacuum beyond, so the environment and distant lights are
-    /// seen through the haze's thickness): `medium: "haze"`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub medium: Option<String>,
-}
-
-/// A lens system camera: a lens file (pbrt's format, with an optional glass
-/// column) and its settings.
-#[derive(Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct LensDesc {
-    /// The lens file, relative to the scene file.
-    pub file: String,
-    /// The aperture stop's opening, a diameter in mm (at most the stop's own).
-    pub aperture_diameter_mm: f32,
-    /// The distance from the film to the plane in focus, in scene units (metres).
-    pub focus_distance: f32,
-    /// The film's diagonal in mm (default 35).
-    #[serde(default = "default_film_diagonal")]
-    pub film_diagonal_mm: f32,
-}
-
-fn default_film_diagonal() -> f32 {
-    35.0
-}
-
-fn default_up() -> V3 {
-    [0.0, 1.0, 0.0]
 }
 
 /// A spectrum in the scene file.
