@@ -13,6 +13,13 @@
 //! the texel's reflectance in place of the constant one). A scene without
 //! textures never computes a (u, v) and pays one branch per hit.
 //!
+//! An object's `emission:` may be a texture too ([`Role::Emission`]): its
+//! colours are uplifted as `Rgb(...)` emission is (the uplifted colour times
+//! D65, scaled: [`crate::color::emission_uplift`]), and the area light keeps
+//! it ([`crate::light::EmissionTexture`]), read at the (u, v) of a hit
+//! ([`crate::scene::Scene::le`]) or of a point the light drew
+//! ([`crate::light::Light::with_radiance`]).
+//!
 //! - `Image(path, uv_scale: (su, sv), uv_offset: (ou, ov), wrap: Repeat | Clamp, scale: S)`:
 //!   a PNG (8 or 16 bits per channel, sRGB-decoded to linear with the
 //!   IEC 61966-2-1 transfer function) or an EXR (linear). The lookup point is
@@ -30,7 +37,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
-use crate::color::{Spectrum, Uplift, fit_rows};
+use crate::color::{N_BINS, Spectrum, Uplift, d65, emission_spectrum, emission_uplift, fit_rows};
 use crate::error::Result;
 use crate::io::image::decode_image;
 use crate::scene::check::Check;
@@ -55,16 +62,37 @@ pub enum Texture {
     Image(Arc<ImageTexture>),
 }
 
-/// An image of uplifted reflectance texels.
+/// An image of uplifted texels: reflectances, or emitted radiances.
 #[derive(Clone, Debug)]
 pub struct ImageTexture {
     width: usize,
     height: usize,
     /// Row 0 is the image's top row.
     texels: Vec<Uplift>,
+    /// For an emission: each texel's factor on `uplift · D65` (see
+    /// [`crate::color::emission_uplift`]); `None` for a reflectance.
+    emission: Option<Box<EmissionTexels>>,
     uv_scale: Vec2,
     uv_offset: Vec2,
     wrap: Wrap,
+}
+
+/// What an emission image keeps besides its uplifted texels.
+#[derive(Clone, Debug)]
+struct EmissionTexels {
+    /// Per texel, index for index with `texels`.
+    scales: Vec<f32>,
+    d65: Spectrum,
+}
+
+/// What an image's texels stand for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// A reflectance: each texel uplifted as `Rgb(...)` is for a material.
+    Reflectance,
+    /// An emitted radiance: each texel uplifted as `Rgb(...)` is for an
+    /// `emission:` (the uplifted colour times D65, scaled).
+    Emission,
 }
 
 impl Texture {
@@ -80,11 +108,27 @@ impl Texture {
             Texture::Image(image) => image.eval(uv),
         }
     }
+
+    /// The mean over the texture's domain and the per-bin peak: the mean of
+    /// the two squares for a checkerboard; for an image the mean of its
+    /// texels (the mean over any whole number of repeats of the image) and
+    /// their per-bin maximum.
+    pub fn mean_and_peak(&self) -> (Spectrum, Spectrum) {
+        match self {
+            Texture::Checkerboard { even, odd, .. } => {
+                ((**even + **odd) * 0.5, Spectrum::from_fn(|b| even[b].max(odd[b])))
+            }
+            Texture::Image(image) => image.mean_and_peak(),
+        }
+    }
 }
 
 impl ImageTexture {
-    /// An image texture of `width` x `height` linear sRGB reflectances (row 0
-    /// at the top), each times `scale`; errors name no field (the caller does).
+    /// An image texture of `width` x `height` linear sRGB colours (row 0 at
+    /// the top), each times `scale`, uplifted for `role`; errors name no field
+    /// (the caller does). An emission's texels must be finite and
+    /// non-negative after scaling.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         width: usize,
         height: usize,
@@ -93,6 +137,7 @@ impl ImageTexture {
         uv_scale: Vec2,
         uv_offset: Vec2,
         wrap: Wrap,
+        role: Role,
     ) -> Result<ImageTexture, String> {
         if width == 0 || height == 0 || rgb.len() != width * height {
             return Err(format!("expected a non-empty image, found {width}x{height}"));
@@ -103,8 +148,60 @@ impl ImageTexture {
         if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
             return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
         }
+        if role == Role::Emission {
+            if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| *c < 0.0)) {
+                return Err(format!(
+                    "texel ({}, {}) is negative, {:?}; expected an emitted colour >= 0",
+                    k % width,
+                    k / width,
+                    rgb[k]
+                ));
+            }
+            if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !(c * scale).is_finite())) {
+                return Err(format!("texel ({}, {}) times the scale {scale} is not finite", k % width, k / width));
+            }
+            let fitted = fit_rows(width, rgb, scale, emission_uplift, |t: &(Uplift, f32)| t.0.coefficients());
+            let (texels, scales) = fitted.into_iter().unzip();
+            let emission = Some(Box::new(EmissionTexels { scales, d65: d65() }));
+            return Ok(ImageTexture { width, height, texels, emission, uv_scale, uv_offset, wrap });
+        }
         let texels = fit_rows(width, rgb, scale, Uplift::reflectance, Uplift::coefficients);
-        Ok(ImageTexture { width, height, texels, uv_scale, uv_offset, wrap })
+        Ok(ImageTexture { width, height, texels, emission: None, uv_scale, uv_offset, wrap })
+    }
+
+    /// Texel `k`'s spectrum.
+    #[inline]
+    fn texel(&self, k: usize) -> Spectrum {
+        match &self.emission {
+            None => self.texels[k].spectrum(),
+            Some(e) => emission_spectrum(&self.texels[k], e.scales[k], &e.d65),
+        }
+    }
+
+    /// True when texels `a` and `b` are the same spectrum.
+    #[inline]
+    fn same(&self, a: usize, b: usize) -> bool {
+        self.texels[a] == self.texels[b] && self.emission.as_ref().is_none_or(|e| e.scales[a] == e.scales[b])
+    }
+
+    /// See [`Texture::mean_and_peak`].
+    fn mean_and_peak(&self) -> (Spectrum, Spectrum) {
+        let mut sum = [0.0f64; N_BINS];
+        let mut peak = Spectrum::ZERO;
+        let mut prev: Option<(usize, Spectrum)> = None;
+        for k in 0..self.texels.len() {
+            let s = match prev {
+                Some((p, s)) if self.same(p, k) => s,
+                _ => self.texel(k),
+            };
+            for b in 0..N_BINS {
+                sum[b] += s[b] as f64;
+                peak[b] = peak[b].max(s[b]);
+            }
+            prev = Some((k, s));
+        }
+        let n = self.texels.len() as f64;
+        (Spectrum::from_fn(|b| (sum[b] / n) as f32), peak)
     }
 
     /// The bilinear blend of the four texels around `uv` (see the module doc).
@@ -118,18 +215,18 @@ impl ImageTexture {
         let (i0, i1) = (self.index(x0, self.width), self.index(x0 + 1.0, self.width));
         let (j0, j1) = (self.index(y0, self.height), self.index(y0 + 1.0, self.height));
         let t = [
-            (self.texels[j0 * self.width + i0], (1.0 - fx) * (1.0 - fy)),
-            (self.texels[j0 * self.width + i1], fx * (1.0 - fy)),
-            (self.texels[j1 * self.width + i0], (1.0 - fx) * fy),
-            (self.texels[j1 * self.width + i1], fx * fy),
+            (j0 * self.width + i0, (1.0 - fx) * (1.0 - fy)),
+            (j0 * self.width + i1, fx * (1.0 - fy)),
+            (j1 * self.width + i0, (1.0 - fx) * fy),
+            (j1 * self.width + i1, fx * fy),
         ];
-        if t.iter().all(|(texel, _)| *texel == t[0].0) {
-            return t[0].0.spectrum();
+        if t.iter().all(|&(k, _)| self.same(k, t[0].0)) {
+            return self.texel(t[0].0);
         }
         let mut s = Spectrum::ZERO;
-        for (texel, weight) in t {
+        for (k, weight) in t {
             if weight > 0.0 {
-                s += texel.spectrum() * weight;
+                s += self.texel(k) * weight;
             }
         }
         s
@@ -150,10 +247,24 @@ impl ImageTexture {
 /// The reflectance at field `field`: a [`Texture`] for `Image` and
 /// `Checkerboard`, else `None` (the caller builds the constant spectrum).
 pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
+    texture_as(check, field, d, Role::Reflectance)
+}
+
+/// The emitted radiance at field `field` (an object's `emission`), as
+/// [`from_desc`]: each colour uplifted as `Rgb(...)` emission is.
+pub(crate) fn emission_from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
+    texture_as(check, field, d, Role::Emission)
+}
+
+fn texture_as(check: &Check, field: &str, d: &SpectrumDesc, role: Role) -> Result<Option<Texture>> {
+    let spectrum = |name: &str, s: &SpectrumDesc| match role {
+        Role::Reflectance => check.reflectance(&format!("{field}.{name}"), s),
+        Role::Emission => check.spectrum(&format!("{field}.{name}"), s),
+    };
     Ok(Some(match d {
         SpectrumDesc::Checkerboard { even, odd, scale } => Texture::Checkerboard {
-            even: Box::new(check.reflectance(&format!("{field}.even"), even)?),
-            odd: Box::new(check.reflectance(&format!("{field}.odd"), odd)?),
+            even: Box::new(spectrum("even", even)?),
+            odd: Box::new(spectrum("odd", odd)?),
             scale: check.positive(&format!("{field}.scale"), *scale)?,
         },
         SpectrumDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
@@ -170,7 +281,7 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<
             let (resolved, bytes) = check.read_input(&path_field, path)?;
             let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
             let rgb = pixels.linear_rgb();
-            let image = ImageTexture::new(w as usize, h as usize, &rgb, scale, uv_scale, uv_offset, *wrap)
+            let image = ImageTexture::new(w as usize, h as usize, &rgb, scale, uv_scale, uv_offset, *wrap, role)
                 .map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
             Texture::Image(Arc::new(image))
         }
@@ -183,7 +294,7 @@ mod tests {
     use super::*;
 
     fn image(w: usize, h: usize, rgb: &[[f32; 3]], wrap: Wrap) -> ImageTexture {
-        ImageTexture::new(w, h, rgb, 1.0, Vec2::ONE, Vec2::ZERO, wrap).unwrap()
+        ImageTexture::new(w, h, rgb, 1.0, Vec2::ONE, Vec2::ZERO, wrap, Role::Reflectance).unwrap()
     }
 
     /// Bilinear weights: at a texel's centre the texel itself; halfway between

@@ -26,3 +26,4 @@ mod scenes;
 mod spectra;
 mod spectral;
 mod stability;
+mod textures;

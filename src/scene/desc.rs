@@ -309,7 +309,7 @@ pub enum SpectrumDesc {
     /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
     /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
     Rgb(f32, f32, f32),
-    /// An image texture (a material's reflectance only; see `crate::texture`):
+    /// An image texture (a material's reflectance or an object's emission; see `crate::texture`):
     /// `Image(path: "wood.png", uv_scale: (2, 2), uv_offset: (0, 0), wrap: Repeat, scale: 1)`.
     Image {
         /// A PNG (sRGB) or EXR (linear) file, relative to the scene file.
@@ -323,11 +323,11 @@ pub enum SpectrumDesc {
         /// Outside [0, 1]: `Repeat` (default) or `Clamp`.
         #[serde(default)]
         wrap: Wrap,
-        /// A factor on every texel (default 1); the product is clamped to [0, 1].
+        /// A factor on every texel (default 1); for a reflectance the product is clamped to [0, 1].
         #[serde(default = "one")]
         scale: f32,
     },
-    /// A checkerboard over (u, v) (a material's reflectance only):
+    /// A checkerboard over (u, v) (a material's reflectance or an object's emission):
     /// `Checkerboard(even: Constant(0.8), odd: Rgb(0.1, 0.1, 0.3), scale: 8)`.
     Checkerboard {
         /// The squares where `⌊N u⌋ + ⌊N v⌋` is even.
@@ -577,7 +577,8 @@ pub struct ObjectDesc {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// Emitted radiance, making the object an area light (spheres, disks,
-    /// quads, cuboids and meshes).
+    /// quads, cuboids and meshes); a spectrum, or a texture (`Image`,
+    /// `Checkerboard`) over the surface's (u, v).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<SpectrumDesc>,
     /// Whether the emission leaves both sides of the surface (default false:

@@ -10,8 +10,8 @@
 //! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: point, normals, primitive, object) |
 //! | the surface coordinates of a hit, for a texture lookup | [`Scene::uv`] (on demand: nothing computes them during traversal) |
 //! | the BSDF at a surface | [`Scene::bsdf_in`] (textures evaluated at the hit); [`Scene::bsdf`] for what no texture changes |
-//! | emission leaving a surface hit | [`Scene::le`], and its light-sampling density for MIS, [`Scene::pdf_li`] |
-//! | a point on a light towards a shading point | [`Scene::sample_li`] |
+//! | emission leaving a surface hit | [`Scene::le`] (a textured emitter's radiance at the hit's (u, v)), and its light-sampling density for MIS, [`Scene::pdf_li`] |
+//! | a point on a light towards a shading point | [`Scene::sample_li`] (its radiance: [`crate::light::Light::with_radiance`] with the choice's `uv`) |
 //! | a ray leaving a light (BDPT, light tracing) | [`Scene::light`] then [`crate::light::Light::sample_le`] |
 //! | the volume a dielectric's surface bounds, and the medium inside | [`Scene::volume`], [`Scene::medium_in`] |
 //! | whether a segment between two points is clear, and its attenuation | [`Scene::transmittance`]: the one visibility rule |
@@ -58,6 +58,9 @@ pub struct LightChoice {
     pub pmf: f32,
     /// The direction, point and density on it.
     pub sample: LightSample,
+    /// The point's surface coordinates on a textured emitter (else zero): the
+    /// `uv` of [`Light::with_radiance`].
+    pub uv: Vec2,
 }
 
 impl Scene {
@@ -173,13 +176,34 @@ impl Scene {
     }
 
     /// The emission leaving surface hit `si` back along `dir` (the direction
-    /// the ray travelled), or `None` where nothing leaves that side.
+    /// the ray travelled), or `None` where nothing leaves that side. A
+    /// textured emitter's radiance at the hit's (u, v) is built in `slot`,
+    /// which the caller keeps for the hit (as [`Scene::bsdf_in`]'s).
     #[inline]
-    pub fn le(&self, si: &SurfaceHit, dir: Vec3) -> Option<Emitted<'_>> {
+    pub fn le<'a>(&'a self, si: &SurfaceHit, dir: Vec3, slot: &'a mut Option<Spectrum>) -> Option<Emitted<'a>> {
         let index = self.emitter(si.object)?;
         let light = &self.lights[index as usize];
         let scale = light.le_scale(si.hit.n, dir);
-        (scale > 0.0).then_some(Emitted { light: index, radiance: light.spectrum(), scale })
+        (scale > 0.0).then_some(())?;
+        let radiance = match light.emission_texture() {
+            None => light.spectrum(),
+            Some(t) => slot.insert(self.textured_emission(&t.texture, si)),
+        };
+        Some(Emitted { light: index, radiance, scale })
+    }
+
+    /// Texture `t` of an emitter at the (u, v) of hit `si` (out of line).
+    #[inline(never)]
+    fn textured_emission(&self, t: &Texture, si: &SurfaceHit) -> Spectrum {
+        t.eval(self.uv(si))
+    }
+
+    /// True when something at a hit on object `object` depends on the hit's
+    /// (u, v): a textured material ([`Scene::texture`]) or a textured emission.
+    #[inline]
+    pub fn needs_uv(&self, object: u32) -> bool {
+        self.texture(object).is_some()
+            || self.emitter(object).is_some_and(|l| self.lights[l as usize].emission_texture().is_some())
     }
 
     /// The environment's light index and its radiance from direction `dir`,
@@ -242,8 +266,8 @@ impl Scene {
     #[inline(always)]
     pub fn sample_li(&self, p: Vec3, u_light: f32, u: glam::Vec2) -> Option<LightChoice> {
         let (index, pmf) = self.choose_light(u_light)?;
-        let sample = self.lights[index].sample_li(p, u)?;
-        Some(LightChoice { light: index as u32, pmf, sample })
+        let (sample, uv) = self.lights[index].sample_li_uv(p, u)?;
+        Some(LightChoice { light: index as u32, pmf, sample, uv })
     }
 
     /// The one visibility rule, for shadow rays and connections of every
