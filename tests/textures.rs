@@ -106,14 +106,16 @@ fn rectangle(p: Vec3, (x0, x1): (f64, f64), (z0, z1): (f64, f64), h: f64, l: f64
 /// with i + j even at radiance 4. A floor pixel of reflectance ρ has Y = ρ E
 /// / π. The camera sees the floor obliquely from below the emitter; the
 /// floor pixels within 0.9 of the emitter's centre are checked (101 of
-/// them), by path tracing (next-event estimation with the texture at the
-/// sampled point, MIS with emission at hits), BDPT (emitted rays from the
+/// them), by every method: Whitted and path tracing (next-event estimation
+/// with the texture at the sampled point; path tracing's MIS with emission
+/// at hits), spectral hero and random, auto, BDPT (emitted rays from the
 /// texture, connections, emission at hits) and light tracing (emitted rays
 /// only). Path tracing at 256 spp: every pixel within 5% (its per-pixel
 /// error is 0.7% on average, 3% at worst, as with a constant emitter).
 /// BDPT and light tracing are noisier per pixel here (with a constant
 /// emitter of the same power, 1.2% and 1.9% on average, up to 5.5% and 7%
-/// at 1024 and 4096 spp), so for every method the pixels where the pattern
+/// at 1024 and 4096 spp; random wavelengths run 2048 spp), so for every
+/// method the pixels where the pattern
 /// matters are summed in two groups: where swapping even and odd would
 /// lower E by more than 10%, and where it would raise E by more than 10%;
 /// each group's sum must be within 2% of the closed form's (so a texture
@@ -145,9 +147,19 @@ fn a_checkerboard_emitter_gives_the_closed_form_irradiance() {
         }
         e
     };
-    for (method, spp) in [(IntegratorKind::Path, 256), (IntegratorKind::Bdpt, 1024), (IntegratorKind::LightTrace, 4096)]
-    {
-        let o = SettingsPatch { max_bounces: Some(1), ..settings(method, 16, spp) };
+    use rust_v::settings::WavelengthsKind;
+    let spectral = |w| (IntegratorKind::Spectral, Some(w));
+    for ((method, wavelengths), spp) in [
+        ((IntegratorKind::Whitted, None), 256),
+        ((IntegratorKind::Path, None), 256),
+        (spectral(WavelengthsKind::Hero), 256),
+        (spectral(WavelengthsKind::Random), 2048),
+        ((IntegratorKind::Auto, None), 256),
+        ((IntegratorKind::Bdpt, None), 1024),
+        ((IntegratorKind::LightTrace, None), 4096),
+    ] {
+        let o = SettingsPatch { max_bounces: Some(1), wavelengths, ..settings(method, 16, spp) };
+        let method = wavelengths.map_or(format!("{method:?}"), |w| format!("{method:?} {w:?}"));
         let scene = load_scene_str(text, std::path::Path::new("checker.ron"), &o).unwrap();
         let film: Film = render_str(text, &o);
         let mut checked = 0;
@@ -164,7 +176,7 @@ fn a_checkerboard_emitter_gives_the_closed_form_irradiance() {
             let want = RHO * irradiance(p, false) / std::f64::consts::PI;
             let swapped = RHO * irradiance(p, true) / std::f64::consts::PI;
             let got = xyz[1];
-            if method == IntegratorKind::Path {
+            if method.starts_with("Path") {
                 assert!((got - want).abs() <= 0.05 * want + 2e-3, "pixel ({x}, {y}) at {p}: Y {got} vs {want}");
             }
             checked += 1;
