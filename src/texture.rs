@@ -13,6 +13,11 @@
 //! the texel's reflectance in place of the constant one). A scene without
 //! textures never computes a (u, v) and pays one branch per hit.
 //!
+//! A material's `roughness:` and a thin film's `thickness_nm:` may be a
+//! texture of numbers ([`ScalarTexture`]: an image's luminance times its
+//! scale, or a checkerboard of two numbers); [`MaterialTextures`] holds every
+//! texture of a material and applies them to its lobe once per hit.
+//!
 //! An object's `emission:` may be a texture too ([`Role::Emission`]): its
 //! colours are uplifted as `Rgb(...)` emission is (the uplifted colour times
 //! D65, scaled: [`crate::color::emission_uplift`]), and the area light keeps
@@ -37,11 +42,13 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
+use crate::bxdf::Bxdf;
+use crate::bxdf::microfacet::SMOOTH_ALPHA;
 use crate::color::{N_BINS, Spectrum, Uplift, d65, emission_spectrum, emission_uplift, fit_rows};
 use crate::error::Result;
 use crate::io::image::decode_image;
 use crate::scene::check::Check;
-use crate::scene::desc::{SpectrumDesc, Wrap};
+use crate::scene::desc::{ScalarTextureDesc, SpectrumDesc, Wrap};
 
 /// The most texels an image texture may have (a 8192 x 8192 image).
 pub const MAX_TEXELS: usize = 1 << 26;
@@ -65,16 +72,62 @@ pub enum Texture {
 /// An image of uplifted texels: reflectances, or emitted radiances.
 #[derive(Clone, Debug)]
 pub struct ImageTexture {
-    width: usize,
-    height: usize,
+    grid: Grid,
     /// Row 0 is the image's top row.
     texels: Vec<Uplift>,
     /// For an emission: each texel's factor on `uplift · D65` (see
     /// [`crate::color::emission_uplift`]); `None` for a reflectance.
     emission: Option<Box<EmissionTexels>>,
+}
+
+/// Where an image's texels lie over (u, v): its size, the lookup's scale and
+/// offset, and how it continues outside [0, 1].
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    width: usize,
+    height: usize,
     uv_scale: Vec2,
     uv_offset: Vec2,
     wrap: Wrap,
+}
+
+impl Grid {
+    /// The four texels around `uv` and their bilinear weights (see the module doc).
+    #[inline]
+    fn taps(&self, uv: Vec2) -> [(usize, f32); 4] {
+        let st = uv * self.uv_scale + self.uv_offset;
+        let x = st.x * self.width as f32 - 0.5;
+        let y = (1.0 - st.y) * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (i0, i1) = (self.index(x0, self.width), self.index(x0 + 1.0, self.width));
+        let (j0, j1) = (self.index(y0, self.height), self.index(y0 + 1.0, self.height));
+        [
+            (j0 * self.width + i0, (1.0 - fx) * (1.0 - fy)),
+            (j0 * self.width + i1, fx * (1.0 - fy)),
+            (j1 * self.width + i0, (1.0 - fx) * fy),
+            (j1 * self.width + i1, fx * fy),
+        ]
+    }
+
+    /// Texel index along an axis of `n` texels for the integer coordinate `x`.
+    #[inline]
+    fn index(&self, x: f32, n: usize) -> usize {
+        // Far outside (or NaN) the coordinate saturates; both modes stay in range.
+        let x = if x.is_finite() { x.clamp(-1e9, 1e9) as i64 } else { 0 };
+        match self.wrap {
+            Wrap::Repeat => x.rem_euclid(n as i64) as usize,
+            Wrap::Clamp => x.clamp(0, n as i64 - 1) as usize,
+        }
+    }
+}
+
+/// True on the squares `(⌊N u⌋, ⌊N v⌋)` of a checkerboard of `scale` squares
+/// per unit whose sum is even.
+#[inline]
+fn even_square(uv: Vec2, scale: f32) -> bool {
+    let (i, j) = ((uv.x * scale).floor() as i64, (uv.y * scale).floor() as i64);
+    (i + j).rem_euclid(2) == 0
 }
 
 /// What an emission image keeps besides its uplifted texels.
@@ -102,8 +155,11 @@ impl Texture {
     pub fn eval(&self, uv: Vec2) -> Spectrum {
         match self {
             Texture::Checkerboard { even, odd, scale } => {
-                let (i, j) = ((uv.x * scale).floor() as i64, (uv.y * scale).floor() as i64);
-                if (i + j).rem_euclid(2) == 0 { **even } else { **odd }
+                if even_square(uv, *scale) {
+                    **even
+                } else {
+                    **odd
+                }
             }
             Texture::Image(image) => image.eval(uv),
         }
@@ -139,15 +195,7 @@ impl ImageTexture {
         wrap: Wrap,
         role: Role,
     ) -> Result<ImageTexture, String> {
-        if width == 0 || height == 0 || rgb.len() != width * height {
-            return Err(format!("expected a non-empty image, found {width}x{height}"));
-        }
-        if width * height > MAX_TEXELS {
-            return Err(format!("{width}x{height} is more than the {MAX_TEXELS} texels a texture may have"));
-        }
-        if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
-        }
+        let grid = Grid::new(width, height, rgb, uv_scale, uv_offset, wrap)?;
         if role == Role::Emission {
             if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| *c < 0.0)) {
                 return Err(format!(
@@ -163,10 +211,10 @@ impl ImageTexture {
             let fitted = fit_rows(width, rgb, scale, emission_uplift, |t: &(Uplift, f32)| t.0.coefficients());
             let (texels, scales) = fitted.into_iter().unzip();
             let emission = Some(Box::new(EmissionTexels { scales, d65: d65() }));
-            return Ok(ImageTexture { width, height, texels, emission, uv_scale, uv_offset, wrap });
+            return Ok(ImageTexture { grid, texels, emission });
         }
         let texels = fit_rows(width, rgb, scale, Uplift::reflectance, Uplift::coefficients);
-        Ok(ImageTexture { width, height, texels, emission: None, uv_scale, uv_offset, wrap })
+        Ok(ImageTexture { grid, texels, emission: None })
     }
 
     /// Texel `k`'s spectrum.
@@ -207,19 +255,7 @@ impl ImageTexture {
     /// The bilinear blend of the four texels around `uv` (see the module doc).
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Spectrum {
-        let st = uv * self.uv_scale + self.uv_offset;
-        let x = st.x * self.width as f32 - 0.5;
-        let y = (1.0 - st.y) * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (i0, i1) = (self.index(x0, self.width), self.index(x0 + 1.0, self.width));
-        let (j0, j1) = (self.index(y0, self.height), self.index(y0 + 1.0, self.height));
-        let t = [
-            (j0 * self.width + i0, (1.0 - fx) * (1.0 - fy)),
-            (j0 * self.width + i1, fx * (1.0 - fy)),
-            (j1 * self.width + i0, (1.0 - fx) * fy),
-            (j1 * self.width + i1, fx * fy),
-        ];
+        let t = self.grid.taps(uv);
         if t.iter().all(|&(k, _)| self.same(k, t[0].0)) {
             return self.texel(t[0].0);
         }
@@ -231,16 +267,153 @@ impl ImageTexture {
         }
         s
     }
+}
 
-    /// Texel index along an axis of `n` texels for the integer coordinate `x`.
-    #[inline]
-    fn index(&self, x: f32, n: usize) -> usize {
-        // Far outside (or NaN) the coordinate saturates; both modes stay in range.
-        let x = if x.is_finite() { x.clamp(-1e9, 1e9) as i64 } else { 0 };
-        match self.wrap {
-            Wrap::Repeat => x.rem_euclid(n as i64) as usize,
-            Wrap::Clamp => x.clamp(0, n as i64 - 1) as usize,
+impl Grid {
+    /// The grid of a `width` x `height` image of colours `rgb` (checked:
+    /// non-empty, at most [`MAX_TEXELS`], finite).
+    fn new(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        uv_scale: Vec2,
+        uv_offset: Vec2,
+        wrap: Wrap,
+    ) -> Result<Grid, String> {
+        if width == 0 || height == 0 || rgb.len() != width * height {
+            return Err(format!("expected a non-empty image, found {width}x{height}"));
         }
+        if width * height > MAX_TEXELS {
+            return Err(format!("{width}x{height} is more than the {MAX_TEXELS} texels a texture may have"));
+        }
+        if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
+        }
+        Ok(Grid { width, height, uv_scale, uv_offset, wrap })
+    }
+}
+
+/// A number over a surface: a roughness (GGX α) or a thin film's thickness
+/// that varies (a material's `roughness:` or `thickness_nm:` given as a
+/// texture, [`crate::scene::desc::ScalarDesc`]).
+#[derive(Clone, Debug)]
+pub enum ScalarTexture {
+    /// Two values in a checkerboard over (u, v), as [`Texture::Checkerboard`].
+    Checkerboard {
+        /// Where `⌊N u⌋ + ⌊N v⌋` is even.
+        even: f32,
+        /// Where it is odd.
+        odd: f32,
+        /// Squares per unit of u and of v.
+        scale: f32,
+    },
+    /// An image of values, looked up as [`ImageTexture`] is.
+    Image(Arc<ScalarImage>),
+}
+
+/// An image of numbers: each texel's luminance times the texture's scale.
+#[derive(Clone, Debug)]
+pub struct ScalarImage {
+    grid: Grid,
+    /// Row 0 is the image's top row.
+    texels: Vec<f32>,
+}
+
+impl ScalarTexture {
+    /// The value at surface coordinates `uv` (out of line, as [`Texture::eval`]).
+    #[inline(never)]
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        match self {
+            ScalarTexture::Checkerboard { even, odd, scale } => {
+                if even_square(uv, *scale) {
+                    *even
+                } else {
+                    *odd
+                }
+            }
+            ScalarTexture::Image(image) => image.eval(uv),
+        }
+    }
+}
+
+impl ScalarImage {
+    /// An image of `width` x `height` linear sRGB colours (row 0 at the top):
+    /// each texel's luminance, `0.2126 R + 0.7152 G + 0.0722 B` (the grey
+    /// itself where R = G = B), times `scale`. Errors name no field.
+    pub fn new(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        scale: f32,
+        uv_scale: Vec2,
+        uv_offset: Vec2,
+        wrap: Wrap,
+    ) -> Result<ScalarImage, String> {
+        let grid = Grid::new(width, height, rgb, uv_scale, uv_offset, wrap)?;
+        let texels = rgb.iter().map(|&[r, g, b]| if r == g && g == b { r } else { luminance(r, g, b) } * scale);
+        Ok(ScalarImage { grid, texels: texels.collect() })
+    }
+
+    /// The bilinear blend of the four texels around `uv`.
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        let t = self.grid.taps(uv);
+        if t.iter().all(|&(k, _)| self.texels[k] == self.texels[t[0].0]) {
+            return self.texels[t[0].0];
+        }
+        t.iter().filter(|(_, w)| *w > 0.0).map(|&(k, w)| self.texels[k] * w).sum()
+    }
+
+    /// The first texel whose value is outside `[lo, hi]` (or NaN), as `(x, y, value)`.
+    fn outside(&self, lo: f32, hi: f32) -> Option<(usize, usize, f32)> {
+        let k = self.texels.iter().position(|v| !(lo..=hi).contains(v))?;
+        Some((k % self.grid.width, k / self.grid.width, self.texels[k]))
+    }
+}
+
+/// The luminance Y of linear sRGB.
+#[inline]
+fn luminance(r: f32, g: f32, b: f32) -> f32 {
+    0.2126 * r + 0.7152 * g + 0.0722 * b
+}
+
+/// Every texture of a material: its reflectance, its GGX α (Conductor,
+/// rough Dielectric, Plastic) and its thin film's thickness (a `ThinFilm`
+/// coating, a `ThinSheet`), each where it varies. [`crate::scene::Scene::bsdf_in`]
+/// applies them once per hit ([`MaterialTextures::apply`]).
+#[derive(Clone, Debug, Default)]
+pub struct MaterialTextures {
+    /// The reflectance (Lambertian, OrenNayar, Mirror, Plastic).
+    pub reflectance: Option<Texture>,
+    /// GGX α: values below [`SMOOTH_ALPHA`] are raised to it at each hit, so
+    /// the material stays a microfacet lobe everywhere (whether a material
+    /// is delta is decided once, not per hit).
+    pub roughness: Option<ScalarTexture>,
+    /// The thickness in nm of the thin film.
+    pub thickness_nm: Option<ScalarTexture>,
+}
+
+impl MaterialTextures {
+    /// True when nothing varies.
+    pub fn is_empty(&self) -> bool {
+        self.reflectance.is_none() && self.roughness.is_none() && self.thickness_nm.is_none()
+    }
+
+    /// The lobe `bxdf` (a material's, built with stand-in values where a
+    /// texture applies) with every texture evaluated at `uv`: exactly the
+    /// lobe of the same material with those values as constants.
+    pub fn apply(&self, bxdf: &Bxdf, uv: Vec2) -> Bxdf {
+        let mut b = match &self.reflectance {
+            Some(t) => bxdf.with_reflectance(t.eval(uv)),
+            None => bxdf.clone(),
+        };
+        if let Some(r) = &self.roughness {
+            b.set_roughness(r.eval(uv).max(SMOOTH_ALPHA));
+        }
+        if let Some(t) = &self.thickness_nm {
+            b.set_thickness_nm(t.eval(uv));
+        }
+        b
     }
 }
 
@@ -270,14 +443,8 @@ fn texture_as(check: &Check, field: &str, d: &SpectrumDesc, role: Role) -> Resul
         SpectrumDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
             let path_field = format!("{field}.path");
             let scale = check.positive(&format!("{field}.scale"), *scale)?;
-            let finite2 = |name: &str, v: [f32; 2]| {
-                if v.iter().all(|c| c.is_finite()) {
-                    Ok(Vec2::from(v))
-                } else {
-                    Err(check.err(format!("{field}.{name}"), format!("expected finite numbers, found {v:?}")))
-                }
-            };
-            let (uv_scale, uv_offset) = (finite2("uv_scale", *uv_scale)?, finite2("uv_offset", *uv_offset)?);
+            let (uv_scale, uv_offset) =
+                (finite2(check, field, "uv_scale", *uv_scale)?, finite2(check, field, "uv_offset", *uv_offset)?);
             let (resolved, bytes) = check.read_input(&path_field, path)?;
             let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
             let rgb = pixels.linear_rgb();
@@ -287,6 +454,59 @@ fn texture_as(check: &Check, field: &str, d: &SpectrumDesc, role: Role) -> Resul
         }
         _ => return Ok(None),
     }))
+}
+
+/// The texture of a scalar at field `field` (`materials."m".roughness`),
+/// every value in `[lo, hi]`; `what` names the quantity in errors (a GGX
+/// alpha, a thickness in nm).
+pub(crate) fn scalar_from_desc(
+    check: &Check,
+    field: &str,
+    d: &ScalarTextureDesc,
+    (lo, hi): (f32, f32),
+    what: &str,
+) -> Result<ScalarTexture> {
+    let in_range = |name: &str, v: f32| {
+        if (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(check.err(format!("{field}.{name}"), format!("expected {what} in [{lo}, {hi}], found {v}")))
+        }
+    };
+    Ok(match d {
+        ScalarTextureDesc::Checkerboard { even, odd, scale } => ScalarTexture::Checkerboard {
+            even: in_range("even", *even)?,
+            odd: in_range("odd", *odd)?,
+            scale: check.positive(&format!("{field}.scale"), *scale)?,
+        },
+        ScalarTextureDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
+            let path_field = format!("{field}.path");
+            let scale = check.positive(&format!("{field}.scale"), *scale)?;
+            let (uv_scale, uv_offset) =
+                (finite2(check, field, "uv_scale", *uv_scale)?, finite2(check, field, "uv_offset", *uv_offset)?);
+            let (resolved, bytes) = check.read_input(&path_field, path)?;
+            let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
+            let image =
+                ScalarImage::new(w as usize, h as usize, &pixels.linear_rgb(), scale, uv_scale, uv_offset, *wrap)
+                    .map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
+            if let Some((x, y, v)) = image.outside(lo, hi) {
+                return Err(check.err(
+                    &path_field,
+                    format!("{path}: texel ({x}, {y}) times the scale is {v}; expected {what} in [{lo}, {hi}]"),
+                ));
+            }
+            ScalarTexture::Image(Arc::new(image))
+        }
+    })
+}
+
+/// A pair of finite numbers at `field.name`.
+fn finite2(check: &Check, field: &str, name: &str, v: [f32; 2]) -> Result<Vec2> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(Vec2::from(v))
+    } else {
+        Err(check.err(format!("{field}.{name}"), format!("expected finite numbers, found {v:?}")))
+    }
 }
 
 #[cfg(test)]

@@ -252,8 +252,9 @@ fn scene_format_covers_every_variant_and_field_of_desc() {
     let ron: String = ron_blocks(&md).into_iter().map(|b| b.text).collect::<Vec<_>>().join("\n");
     let words: BTreeSet<String> =
         ron.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).map(str::to_string).collect();
-    // ScaleDesc is untagged: its variants are never written (`scale: 0.5` or `(x, y, z)`).
-    let (variants, fields) = desc_names(&read(&root().join("src/scene/desc.rs")), &["ScaleDesc"]);
+    // ScaleDesc and ScalarDesc are untagged: their variants are never written (`scale: 0.5`
+    // or `(x, y, z)`; `roughness: 0.2` or a texture).
+    let (variants, fields) = desc_names(&read(&root().join("src/scene/desc.rs")), &["ScaleDesc", "ScalarDesc"]);
     assert!(variants.len() >= 30 && fields.len() >= 30, "desc.rs parsed badly: {variants:?} {fields:?}");
     let settings_src = read(&root().join("src/settings.rs"));
     let start = settings_src.find("\nsettings! {").expect("the settings! invocation in src/settings.rs");

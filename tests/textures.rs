@@ -198,3 +198,121 @@ fn a_checkerboard_emitter_gives_the_closed_form_irradiance() {
         }
     }
 }
+
+/// A plane of material `material` (with `{A}` standing for its scalar
+/// parameter) under a uniform sky and a sphere light, seen from above at an
+/// angle (no surface sees another: each pixel's paths meet the plane once).
+fn plane(material: &str, value: &str) -> String {
+    let material = material.replace("{A}", value);
+    format!(
+        r#"(
+    camera: (eye: (0, 1.6, 1.6), look_at: (0, 0, 0), fov_deg: 50),
+    materials: {{ "m": {material} }},
+    objects: [
+        (shape: Quad(origin: (-2, 0, 2), edge_u: (4, 0, 0), edge_v: (0, 0, -4)), material: "m"),
+        (shape: Sphere(center: (0.4, 1.2, -0.8), radius: 0.25), emission: Constant(8)),
+    ],
+    environment: Uniform(Rgb(0.3, 0.5, 0.9)),
+)"#
+    )
+}
+
+/// The materials whose scalar parameters may be textures, `{A}` for the
+/// parameter, and the checkerboard's two values.
+const SCALAR_CASES: [(&str, f32, f32); 6] = [
+    (r#"Conductor(metal: "Au", roughness: {A})"#, 0.1, 0.4),
+    (r#"Plastic(reflectance: Rgb(0.7, 0.2, 0.1), ior: Constant(1.5), roughness: {A})"#, 0.05, 0.3),
+    (r#"Dielectric(ior: Constant(1.5), roughness: {A})"#, 0.2, 0.6),
+    (
+        r#"Conductor(metal: "Cu", roughness: 0.2, coating: ThinFilm(thickness_nm: {A}, ior: Constant(1.45)))"#,
+        120.0,
+        480.0,
+    ),
+    (r#"Dielectric(ior: Constant(1.5), coating: ThinFilm(thickness_nm: {A}, ior: Constant(1.38)))"#, 0.0, 300.0),
+    (r#"ThinSheet(thickness_nm: {A}, ior: Constant(1.33))"#, 250.0, 700.0),
+];
+
+/// A checkerboard of roughness (GGX α of a conductor, a plastic's coat, rough
+/// glass) or of thin-film thickness (a coating on metal and on glass, a thin
+/// sheet) renders every pixel that lies within one square bit for bit like
+/// the same material with that square's value as a constant: the texture is
+/// evaluated once per hit into the lobe, which is then exactly the constant
+/// material's. A pixel lies within one square when the (u, v) its four
+/// corners see fall in the same square (the squares are convex and a pixel's
+/// footprint on the plane is a convex quadrilateral). Methods whose pixels
+/// depend only on the surface point they see (path tracing, Whitted, spectral
+/// hero, auto, light tracing: the plane meets each path once); BDPT's
+/// connections join a pixel's camera vertex with light vertices anywhere on
+/// the plane, so it is not asserted here. At least 40 pixels per square kind.
+#[test]
+fn a_scalar_checkerboard_renders_each_square_like_its_constant() {
+    use rust_v::settings::WavelengthsKind;
+    let methods = [
+        (IntegratorKind::Path, None),
+        (IntegratorKind::Whitted, None),
+        (IntegratorKind::Spectral, Some(WavelengthsKind::Hero)),
+        (IntegratorKind::Auto, None),
+        (IntegratorKind::LightTrace, None),
+    ];
+    let n = 24;
+    for (material, even, odd) in SCALAR_CASES {
+        let textured = plane(material, &format!("Checkerboard(even: {even:?}, odd: {odd:?}, scale: 2)"));
+        let o = settings(IntegratorKind::Path, n, 4);
+        let scene = load_scene_str(&textured, std::path::Path::new("plane.ron"), &o).unwrap();
+        // The square (i, j) each pixel lies within, if one.
+        let square = |x: u32, y: u32| {
+            let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(dx, dy)| {
+                let ray = scene.camera.ray(Vec2::new(x as f32 + dx, y as f32 + dy));
+                let si = scene.intersect(&ray, f32::INFINITY).filter(|s| s.object == 0)?;
+                let uv = scene.uv(&si) * 2.0;
+                Some((uv.x.floor() as i64, uv.y.floor() as i64))
+            });
+            let first = corners[0]?;
+            corners.iter().all(|c| *c == Some(first)).then_some(first)
+        };
+        let squares: Vec<Option<(i64, i64)>> = (0..n * n).map(|k| square(k % n, k / n)).collect();
+        for (method, wavelengths) in methods {
+            let o = SettingsPatch { wavelengths, ..settings(method, n, 4) };
+            let got = render_str(&textured, &o).mean_xyz();
+            let want_even = render_str(&plane(material, &format!("{even:?}")), &o).mean_xyz();
+            let want_odd = render_str(&plane(material, &format!("{odd:?}")), &o).mean_xyz();
+            let mut counts = [0; 2];
+            for (k, sq) in squares.iter().enumerate() {
+                let Some((i, j)) = sq else { continue };
+                let odd_square = (i + j).rem_euclid(2) == 1;
+                let want = if odd_square { want_odd[k] } else { want_even[k] };
+                assert_eq!(got[k], want, "{material} {method:?}: pixel {k} in square ({i}, {j})");
+                counts[usize::from(odd_square)] += 1;
+            }
+            assert!(counts[0] >= 40 && counts[1] >= 40, "{material}: {counts:?} pixels within a square");
+        }
+        // The two constants render differently (the test can fail).
+        let o = settings(IntegratorKind::Path, n, 4);
+        let (a, b) = (
+            render_str(&plane(material, &format!("{even:?}")), &o).mean_xyz(),
+            render_str(&plane(material, &format!("{odd:?}")), &o).mean_xyz(),
+        );
+        let differ = squares.iter().zip(a.iter().zip(&b)).filter(|(s, (a, b))| s.is_some() && a != b).count();
+        assert!(differ >= 40, "{material}: the two values differ in only {differ} pixels");
+    }
+}
+
+/// A roughness or thickness image of one grey renders bit for bit like that
+/// number (a grey texel's value is the grey itself, times `scale`; a lookup
+/// between equal texels returns the texel); an EXR of 0.25 times `scale: 0.8`
+/// is α 0.2 and 200 nm exactly at scale 800.
+#[test]
+fn a_one_grey_scalar_image_renders_exactly_like_its_number() {
+    let dir = temp_dir("textures_one_grey");
+    let exr = dir.join("grey.exr");
+    image::Rgb32FImage::from_raw(3, 2, vec![0.25f32; 18]).unwrap().save(&exr).unwrap();
+    for (material, scale, value) in [(SCALAR_CASES[0].0, 0.8, "0.2"), (SCALAR_CASES[5].0, 800.0, "200")] {
+        let image = format!(r#"Image(path: "{}", scale: {scale:?})"#, exr.display());
+        for method in [IntegratorKind::Path, IntegratorKind::Bdpt] {
+            let o = settings(method, 12, 4);
+            let a = render_str(&plane(material, &image), &o).mean_xyz();
+            let b = render_str(&plane(material, value), &o).mean_xyz();
+            assert_eq!(a, b, "{material} {method:?}");
+        }
+    }
+}

@@ -155,6 +155,16 @@ impl Light {
         }
     }
 
+    /// [`Light::with_radiance`] for a light without an emission texture
+    /// (cheaper: one branch, for the environment).
+    #[inline(always)]
+    pub fn with_radiance_at<R>(&self, wi: Vec3, f: impl FnOnce(&Spectrum) -> R) -> R {
+        match self {
+            Light::Environment(l) => f(&l.radiance(wi)),
+            _ => f(self.spectrum()),
+        }
+    }
+
     /// The texture of a textured area light's radiance.
     #[inline]
     pub fn emission_texture(&self) -> Option<&EmissionTexture> {

@@ -31,7 +31,7 @@ use crate::geometry::Ray;
 use crate::light::{Light, LightSample};
 use crate::medium::{Crossing, Medium, Volume, VolumeStack};
 use crate::spectral::Lambdas;
-use crate::texture::Texture;
+use crate::texture::{MaterialTextures, Texture};
 
 /// The most false intersections a path or a segment passes in a row before it
 /// ends (a guard against degenerate geometry; real scenes need a handful).
@@ -92,10 +92,10 @@ impl Scene {
         }
     }
 
-    /// Object `object`'s lobe with texture `t` evaluated at `uv` (out of line).
+    /// Object `object`'s lobe with textures `t` evaluated at `uv` (out of line).
     #[inline(never)]
-    fn textured(&self, object: u32, t: &Texture, uv: Vec2) -> Bxdf {
-        self.bsdf(object).with_reflectance(t.eval(uv))
+    fn textured(&self, object: u32, t: &MaterialTextures, uv: Vec2) -> Bxdf {
+        t.apply(self.bsdf(object), uv)
     }
 
     /// The BSDF of object `object` at surface coordinates `uv` (as
@@ -108,9 +108,10 @@ impl Scene {
         }
     }
 
-    /// The reflectance texture of object `object`'s material, if it has one.
+    /// The textures of object `object`'s material (reflectance, roughness,
+    /// film thickness), if it has any.
     #[inline]
-    pub fn texture(&self, object: u32) -> Option<&Texture> {
+    pub fn texture(&self, object: u32) -> Option<&MaterialTextures> {
         if self.textures.is_empty() {
             return None;
         }
@@ -186,8 +187,8 @@ impl Scene {
         let scale = light.le_scale(si.hit.n, dir);
         (scale > 0.0).then_some(())?;
         let radiance = match light.emission_texture() {
-            None => light.spectrum(),
-            Some(t) => slot.insert(self.textured_emission(&t.texture, si)),
+            Some(t) if self.emission_textures => slot.insert(self.textured_emission(&t.texture, si)),
+            _ => light.spectrum(),
         };
         Some(Emitted { light: index, radiance, scale })
     }
@@ -203,7 +204,8 @@ impl Scene {
     #[inline]
     pub fn needs_uv(&self, object: u32) -> bool {
         self.texture(object).is_some()
-            || self.emitter(object).is_some_and(|l| self.lights[l as usize].emission_texture().is_some())
+            || (self.emission_textures
+                && self.emitter(object).is_some_and(|l| self.lights[l as usize].emission_texture().is_some()))
     }
 
     /// The environment's light index and its radiance from direction `dir`,
@@ -266,8 +268,20 @@ impl Scene {
     #[inline(always)]
     pub fn sample_li(&self, p: Vec3, u_light: f32, u: glam::Vec2) -> Option<LightChoice> {
         let (index, pmf) = self.choose_light(u_light)?;
-        let (sample, uv) = self.lights[index].sample_li_uv(p, u)?;
+        let light = &self.lights[index];
+        let (sample, uv) =
+            if self.emission_textures { light.sample_li_uv(p, u)? } else { (light.sample_li(p, u)?, Vec2::ZERO) };
         Some(LightChoice { light: index as u32, pmf, sample, uv })
+    }
+
+    /// `f` of the radiance arriving from light `light` along `wi` from its
+    /// point of surface coordinates `uv` ([`Light::with_radiance`]; a scene
+    /// without emission textures asks only [`Light::with_radiance_at`]'s
+    /// cheaper question).
+    #[inline(always)]
+    pub fn with_radiance<R>(&self, light: u32, wi: Vec3, uv: Vec2, f: impl FnOnce(&Spectrum) -> R) -> R {
+        let light = &self.lights[light as usize];
+        if self.emission_textures { light.with_radiance(wi, uv, f) } else { light.with_radiance_at(wi, f) }
     }
 
     /// The one visibility rule, for shadow rays and connections of every
