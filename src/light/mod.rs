@@ -146,12 +146,22 @@ impl Light {
     /// other lights paying for the copy.
     #[inline(always)]
     pub fn with_radiance<R>(&self, wi: Vec3, uv: Vec2, f: impl FnOnce(&Spectrum) -> R) -> R {
-        match self {
-            Light::Environment(l) => f(&l.radiance(wi)),
-            Light::Area(AreaLight { texture: Some(t), .. })
-            | Light::Sphere(SphereLight { texture: Some(t), .. })
-            | Light::Disk(DiskLight { texture: Some(t), .. }) => f(&t.texture.eval(uv)),
-            _ => f(self.spectrum()),
+        let mut slot = None;
+        let s = match self {
+            Light::Environment(l) => slot.insert(l.radiance(wi)),
+            _ => self.radiance_in(uv, &mut slot),
+        };
+        f(s)
+    }
+
+    /// The radiance of a light other than the environment from its point of
+    /// surface coordinates `uv`: a textured area light's texture there (built
+    /// in `slot`), any other light's one spectrum.
+    #[inline]
+    pub fn radiance_in<'a>(&'a self, uv: Vec2, slot: &'a mut Option<Spectrum>) -> &'a Spectrum {
+        match self.emission_texture() {
+            Some(t) => slot.insert(t.texture.eval(uv)),
+            None => self.spectrum(),
         }
     }
 
