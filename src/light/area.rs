@@ -239,7 +239,7 @@ impl AreaLight {
     #[inline]
     pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
         let (point, n, uv) = self.sample_point(u_pos);
-        surface_ray(point, n, self.area(), self.two_sided, u_dir).map(|e| EmissionSample { uv, ..e })
+        surface_ray(point, n, uv, self.area(), self.two_sided, u_dir)
     }
 
     /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].

@@ -87,8 +87,7 @@ impl DiskLight {
         let q = concentric_disk(u_pos) * self.disk.radius;
         let point = self.disk.center + Frame::from_z(self.disk.normal).to_world(Vec3::new(q.x, q.y, 0.0));
         let area = PI * self.disk.radius * self.disk.radius;
-        surface_ray(point, self.disk.normal, area, self.two_sided, u_dir)
-            .map(|e| EmissionSample { uv: self.uv(point), ..e })
+        surface_ray(point, self.disk.normal, self.uv(point), area, self.two_sided, u_dir)
     }
 
     /// The (u, v) of `point` on the disk when the light has a texture (else zero).

@@ -117,9 +117,17 @@ impl Light {
     }
 }
 
-/// A cosine-distributed ray from a point of an area light.
+/// A cosine-distributed ray from a point of an area light (of surface
+/// coordinates `uv` on a textured light, else zero).
 #[inline]
-pub(super) fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Option<EmissionSample> {
+pub(super) fn surface_ray(
+    point: Vec3,
+    n: Vec3,
+    uv: Vec2,
+    area: f32,
+    two_sided: bool,
+    u: Vec2,
+) -> Option<EmissionSample> {
     if area.is_nan() || area <= 0.0 {
         return None;
     }
@@ -135,15 +143,7 @@ pub(super) fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: V
         return None;
     }
     let dir = Frame::from_z(side).to_world(local).normalize();
-    Some(EmissionSample {
-        point,
-        n,
-        dir,
-        pdf_pos: 1.0 / area,
-        pdf_dir: pick * local.z / PI,
-        scale: 1.0,
-        uv: Vec2::ZERO,
-    })
+    Some(EmissionSample { point, n, dir, pdf_pos: 1.0 / area, pdf_dir: pick * local.z / PI, scale: 1.0, uv })
 }
 
 /// The direction density of [`surface_ray`].

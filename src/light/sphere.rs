@@ -146,7 +146,7 @@ impl SphereLight {
         let n = uniform_sphere(u_pos);
         let point = self.sphere.center + n * self.sphere.radius;
         let area = 4.0 * PI * self.sphere.radius * self.sphere.radius;
-        surface_ray(point, n, area, self.two_sided, u_dir).map(|e| EmissionSample { uv: self.uv(point), ..e })
+        surface_ray(point, n, self.uv(point), area, self.two_sided, u_dir)
     }
 
     /// The (u, v) of `point` on the sphere when the light has a texture (else zero).
