@@ -13,6 +13,18 @@
 //! the texel's reflectance in place of the constant one). A scene without
 //! textures never computes a (u, v) and pays one branch per hit.
 //!
+//! A material's `roughness:` and a thin film's `thickness_nm:` may be a
+//! texture of numbers ([`ScalarTexture`]: an image's luminance times its
+//! scale, or a checkerboard of two numbers); [`MaterialTextures`] holds every
+//! texture of a material and applies them to its lobe once per hit.
+//!
+//! An object's `emission:` may be a texture too ([`Role::Emission`]): its
+//! colours are uplifted as `Rgb(...)` emission is (the uplifted colour times
+//! D65, scaled: [`crate::color::emission_uplift`]), and the area light keeps
+//! it ([`crate::light::EmissionTexture`]), read at the (u, v) of a hit
+//! ([`crate::scene::Scene::le`]) or of a point the light drew
+//! ([`crate::light::Light::with_radiance`]).
+//!
 //! - `Image(path, uv_scale: (su, sv), uv_offset: (ou, ov), wrap: Repeat | Clamp, scale: S)`:
 //!   a PNG (8 or 16 bits per channel, sRGB-decoded to linear with the
 //!   IEC 61966-2-1 transfer function) or an EXR (linear). The lookup point is
@@ -30,11 +42,13 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
-use crate::color::{Spectrum, Uplift, fit_rows};
+use crate::bxdf::Bxdf;
+use crate::bxdf::microfacet::SMOOTH_ALPHA;
+use crate::color::{N_BINS, Spectrum, Uplift, d65, emission_spectrum, emission_uplift, fit_rows};
 use crate::error::Result;
 use crate::io::image::decode_image;
 use crate::scene::check::Check;
-use crate::scene::desc::{SpectrumDesc, Wrap};
+use crate::scene::desc::{ScalarTextureDesc, SpectrumDesc, Wrap};
 
 /// The most texels an image texture may have (a 8192 x 8192 image).
 pub const MAX_TEXELS: usize = 1 << 26;
@@ -55,61 +69,32 @@ pub enum Texture {
     Image(Arc<ImageTexture>),
 }
 
-/// An image of uplifted reflectance texels.
+/// An image of uplifted texels: reflectances, or emitted radiances.
 #[derive(Clone, Debug)]
 pub struct ImageTexture {
-    width: usize,
-    height: usize,
+    grid: Grid,
     /// Row 0 is the image's top row.
     texels: Vec<Uplift>,
+    /// For an emission: each texel's factor on `uplift · D65` (see
+    /// [`crate::color::emission_uplift`]); `None` for a reflectance.
+    emission: Option<Box<EmissionTexels>>,
+}
+
+/// Where an image's texels lie over (u, v): its size, the lookup's scale and
+/// offset, and how it continues outside [0, 1].
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    width: usize,
+    height: usize,
     uv_scale: Vec2,
     uv_offset: Vec2,
     wrap: Wrap,
 }
 
-impl Texture {
-    /// The reflectance at surface coordinates `uv` (out of line: the hot path of
-    /// an untextured scene stays small).
-    #[inline(never)]
-    pub fn eval(&self, uv: Vec2) -> Spectrum {
-        match self {
-            Texture::Checkerboard { even, odd, scale } => {
-                let (i, j) = ((uv.x * scale).floor() as i64, (uv.y * scale).floor() as i64);
-                if (i + j).rem_euclid(2) == 0 { **even } else { **odd }
-            }
-            Texture::Image(image) => image.eval(uv),
-        }
-    }
-}
-
-impl ImageTexture {
-    /// An image texture of `width` x `height` linear sRGB reflectances (row 0
-    /// at the top), each times `scale`; errors name no field (the caller does).
-    pub fn new(
-        width: usize,
-        height: usize,
-        rgb: &[[f32; 3]],
-        scale: f32,
-        uv_scale: Vec2,
-        uv_offset: Vec2,
-        wrap: Wrap,
-    ) -> Result<ImageTexture, String> {
-        if width == 0 || height == 0 || rgb.len() != width * height {
-            return Err(format!("expected a non-empty image, found {width}x{height}"));
-        }
-        if width * height > MAX_TEXELS {
-            return Err(format!("{width}x{height} is more than the {MAX_TEXELS} texels a texture may have"));
-        }
-        if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
-        }
-        let texels = fit_rows(width, rgb, scale, Uplift::reflectance, Uplift::coefficients);
-        Ok(ImageTexture { width, height, texels, uv_scale, uv_offset, wrap })
-    }
-
-    /// The bilinear blend of the four texels around `uv` (see the module doc).
+impl Grid {
+    /// The four texels around `uv` and their bilinear weights (see the module doc).
     #[inline]
-    pub fn eval(&self, uv: Vec2) -> Spectrum {
+    fn taps(&self, uv: Vec2) -> [(usize, f32); 4] {
         let st = uv * self.uv_scale + self.uv_offset;
         let x = st.x * self.width as f32 - 0.5;
         let y = (1.0 - st.y) * self.height as f32 - 0.5;
@@ -117,22 +102,12 @@ impl ImageTexture {
         let (fx, fy) = (x - x0, y - y0);
         let (i0, i1) = (self.index(x0, self.width), self.index(x0 + 1.0, self.width));
         let (j0, j1) = (self.index(y0, self.height), self.index(y0 + 1.0, self.height));
-        let t = [
-            (self.texels[j0 * self.width + i0], (1.0 - fx) * (1.0 - fy)),
-            (self.texels[j0 * self.width + i1], fx * (1.0 - fy)),
-            (self.texels[j1 * self.width + i0], (1.0 - fx) * fy),
-            (self.texels[j1 * self.width + i1], fx * fy),
-        ];
-        if t.iter().all(|(texel, _)| *texel == t[0].0) {
-            return t[0].0.spectrum();
-        }
-        let mut s = Spectrum::ZERO;
-        for (texel, weight) in t {
-            if weight > 0.0 {
-                s += texel.spectrum() * weight;
-            }
-        }
-        s
+        [
+            (j0 * self.width + i0, (1.0 - fx) * (1.0 - fy)),
+            (j0 * self.width + i1, fx * (1.0 - fy)),
+            (j1 * self.width + i0, (1.0 - fx) * fy),
+            (j1 * self.width + i1, fx * fy),
+        ]
     }
 
     /// Texel index along an axis of `n` texels for the integer coordinate `x`.
@@ -147,30 +122,333 @@ impl ImageTexture {
     }
 }
 
+/// True on the squares `(⌊N u⌋, ⌊N v⌋)` of a checkerboard of `scale` squares
+/// per unit whose sum is even.
+#[inline]
+fn even_square(uv: Vec2, scale: f32) -> bool {
+    let (i, j) = ((uv.x * scale).floor() as i64, (uv.y * scale).floor() as i64);
+    (i + j).rem_euclid(2) == 0
+}
+
+/// What an emission image keeps besides its uplifted texels.
+#[derive(Clone, Debug)]
+struct EmissionTexels {
+    /// Per texel, index for index with `texels`.
+    scales: Vec<f32>,
+    d65: Spectrum,
+}
+
+/// What an image's texels stand for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// A reflectance: each texel uplifted as `Rgb(...)` is for a material.
+    Reflectance,
+    /// An emitted radiance: each texel uplifted as `Rgb(...)` is for an
+    /// `emission:` (the uplifted colour times D65, scaled).
+    Emission,
+}
+
+impl Texture {
+    /// The reflectance at surface coordinates `uv` (out of line: the hot path of
+    /// an untextured scene stays small).
+    #[inline(never)]
+    pub fn eval(&self, uv: Vec2) -> Spectrum {
+        match self {
+            Texture::Checkerboard { even, odd, scale } => {
+                if even_square(uv, *scale) {
+                    **even
+                } else {
+                    **odd
+                }
+            }
+            Texture::Image(image) => image.eval(uv),
+        }
+    }
+
+    /// The mean over the texture's domain and the per-bin peak: the mean of
+    /// the two squares for a checkerboard; for an image the mean of its
+    /// texels (the mean over any whole number of repeats of the image) and
+    /// their per-bin maximum.
+    pub fn mean_and_peak(&self) -> (Spectrum, Spectrum) {
+        match self {
+            Texture::Checkerboard { even, odd, .. } => {
+                ((**even + **odd) * 0.5, Spectrum::from_fn(|b| even[b].max(odd[b])))
+            }
+            Texture::Image(image) => image.mean_and_peak(),
+        }
+    }
+}
+
+impl ImageTexture {
+    /// An image texture of `width` x `height` linear sRGB colours (row 0 at
+    /// the top), each times `scale`, uplifted for `role`; errors name no field
+    /// (the caller does). An emission's texels must be finite and
+    /// non-negative after scaling.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        scale: f32,
+        uv_scale: Vec2,
+        uv_offset: Vec2,
+        wrap: Wrap,
+        role: Role,
+    ) -> Result<ImageTexture, String> {
+        let grid = Grid::new(width, height, rgb, uv_scale, uv_offset, wrap)?;
+        if role == Role::Emission {
+            if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| *c < 0.0)) {
+                return Err(format!(
+                    "texel ({}, {}) is negative, {:?}; expected an emitted colour >= 0",
+                    k % width,
+                    k / width,
+                    rgb[k]
+                ));
+            }
+            if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !(c * scale).is_finite())) {
+                return Err(format!("texel ({}, {}) times the scale {scale} is not finite", k % width, k / width));
+            }
+            let fitted = fit_rows(width, rgb, scale, emission_uplift, |t: &(Uplift, f32)| t.0.coefficients());
+            let (texels, scales) = fitted.into_iter().unzip();
+            let emission = Some(Box::new(EmissionTexels { scales, d65: d65() }));
+            return Ok(ImageTexture { grid, texels, emission });
+        }
+        let texels = fit_rows(width, rgb, scale, Uplift::reflectance, Uplift::coefficients);
+        Ok(ImageTexture { grid, texels, emission: None })
+    }
+
+    /// Texel `k`'s spectrum.
+    #[inline]
+    fn texel(&self, k: usize) -> Spectrum {
+        match &self.emission {
+            None => self.texels[k].spectrum(),
+            Some(e) => emission_spectrum(&self.texels[k], e.scales[k], &e.d65),
+        }
+    }
+
+    /// True when texels `a` and `b` are the same spectrum.
+    #[inline]
+    fn same(&self, a: usize, b: usize) -> bool {
+        self.texels[a] == self.texels[b] && self.emission.as_ref().is_none_or(|e| e.scales[a] == e.scales[b])
+    }
+
+    /// See [`Texture::mean_and_peak`].
+    fn mean_and_peak(&self) -> (Spectrum, Spectrum) {
+        let mut sum = [0.0f64; N_BINS];
+        let mut peak = Spectrum::ZERO;
+        let mut prev: Option<(usize, Spectrum)> = None;
+        for k in 0..self.texels.len() {
+            let s = match prev {
+                Some((p, s)) if self.same(p, k) => s,
+                _ => self.texel(k),
+            };
+            for b in 0..N_BINS {
+                sum[b] += s[b] as f64;
+                peak[b] = peak[b].max(s[b]);
+            }
+            prev = Some((k, s));
+        }
+        let n = self.texels.len() as f64;
+        (Spectrum::from_fn(|b| (sum[b] / n) as f32), peak)
+    }
+
+    /// The bilinear blend of the four texels around `uv` (see the module doc).
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> Spectrum {
+        let t = self.grid.taps(uv);
+        if t.iter().all(|&(k, _)| self.same(k, t[0].0)) {
+            return self.texel(t[0].0);
+        }
+        let mut s = Spectrum::ZERO;
+        for (k, weight) in t {
+            if weight > 0.0 {
+                s += self.texel(k) * weight;
+            }
+        }
+        s
+    }
+}
+
+impl Grid {
+    /// The grid of a `width` x `height` image of colours `rgb` (checked:
+    /// non-empty, at most [`MAX_TEXELS`], finite).
+    fn new(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        uv_scale: Vec2,
+        uv_offset: Vec2,
+        wrap: Wrap,
+    ) -> Result<Grid, String> {
+        if width == 0 || height == 0 || rgb.len() != width * height {
+            return Err(format!("expected a non-empty image, found {width}x{height}"));
+        }
+        if width * height > MAX_TEXELS {
+            return Err(format!("{width}x{height} is more than the {MAX_TEXELS} texels a texture may have"));
+        }
+        if let Some(k) = rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(format!("texel ({}, {}) is not a finite colour", k % width, k / width));
+        }
+        Ok(Grid { width, height, uv_scale, uv_offset, wrap })
+    }
+}
+
+/// A number over a surface: a roughness (GGX α) or a thin film's thickness
+/// that varies (a material's `roughness:` or `thickness_nm:` given as a
+/// texture, [`crate::scene::desc::ScalarDesc`]).
+#[derive(Clone, Debug)]
+pub enum ScalarTexture {
+    /// Two values in a checkerboard over (u, v), as [`Texture::Checkerboard`].
+    Checkerboard {
+        /// Where `⌊N u⌋ + ⌊N v⌋` is even.
+        even: f32,
+        /// Where it is odd.
+        odd: f32,
+        /// Squares per unit of u and of v.
+        scale: f32,
+    },
+    /// An image of values, looked up as [`ImageTexture`] is.
+    Image(Arc<ScalarImage>),
+}
+
+/// An image of numbers: each texel's luminance times the texture's scale.
+#[derive(Clone, Debug)]
+pub struct ScalarImage {
+    grid: Grid,
+    /// Row 0 is the image's top row.
+    texels: Vec<f32>,
+}
+
+impl ScalarTexture {
+    /// The value at surface coordinates `uv` (out of line, as [`Texture::eval`]).
+    #[inline(never)]
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        match self {
+            ScalarTexture::Checkerboard { even, odd, scale } => {
+                if even_square(uv, *scale) {
+                    *even
+                } else {
+                    *odd
+                }
+            }
+            ScalarTexture::Image(image) => image.eval(uv),
+        }
+    }
+}
+
+impl ScalarImage {
+    /// An image of `width` x `height` linear sRGB colours (row 0 at the top):
+    /// each texel's luminance, `0.2126 R + 0.7152 G + 0.0722 B` (the grey
+    /// itself where R = G = B), times `scale`. Errors name no field.
+    pub fn new(
+        width: usize,
+        height: usize,
+        rgb: &[[f32; 3]],
+        scale: f32,
+        uv_scale: Vec2,
+        uv_offset: Vec2,
+        wrap: Wrap,
+    ) -> Result<ScalarImage, String> {
+        let grid = Grid::new(width, height, rgb, uv_scale, uv_offset, wrap)?;
+        let texels = rgb.iter().map(|&[r, g, b]| if r == g && g == b { r } else { luminance(r, g, b) } * scale);
+        Ok(ScalarImage { grid, texels: texels.collect() })
+    }
+
+    /// The bilinear blend of the four texels around `uv`.
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        let t = self.grid.taps(uv);
+        if t.iter().all(|&(k, _)| self.texels[k] == self.texels[t[0].0]) {
+            return self.texels[t[0].0];
+        }
+        t.iter().filter(|(_, w)| *w > 0.0).map(|&(k, w)| self.texels[k] * w).sum()
+    }
+
+    /// The first texel whose value is outside `[lo, hi]` (or NaN), as `(x, y, value)`.
+    fn outside(&self, lo: f32, hi: f32) -> Option<(usize, usize, f32)> {
+        let k = self.texels.iter().position(|v| !(lo..=hi).contains(v))?;
+        Some((k % self.grid.width, k / self.grid.width, self.texels[k]))
+    }
+}
+
+/// The luminance Y of linear sRGB.
+#[inline]
+fn luminance(r: f32, g: f32, b: f32) -> f32 {
+    0.2126 * r + 0.7152 * g + 0.0722 * b
+}
+
+/// Every texture of a material: its reflectance, its GGX α (Conductor,
+/// rough Dielectric, Plastic) and its thin film's thickness (a `ThinFilm`
+/// coating, a `ThinSheet`), each where it varies. [`crate::scene::Scene::bsdf_in`]
+/// applies them once per hit ([`MaterialTextures::apply`]).
+#[derive(Clone, Debug, Default)]
+pub struct MaterialTextures {
+    /// The reflectance (Lambertian, OrenNayar, Mirror, Plastic).
+    pub reflectance: Option<Texture>,
+    /// GGX α: values below [`SMOOTH_ALPHA`] are raised to it at each hit, so
+    /// the material stays a microfacet lobe everywhere (whether a material
+    /// is delta is decided once, not per hit).
+    pub roughness: Option<ScalarTexture>,
+    /// The thickness in nm of the thin film.
+    pub thickness_nm: Option<ScalarTexture>,
+}
+
+impl MaterialTextures {
+    /// True when nothing varies.
+    pub fn is_empty(&self) -> bool {
+        self.reflectance.is_none() && self.roughness.is_none() && self.thickness_nm.is_none()
+    }
+
+    /// The lobe `bxdf` (a material's, built with stand-in values where a
+    /// texture applies) with every texture evaluated at `uv`: exactly the
+    /// lobe of the same material with those values as constants.
+    pub fn apply(&self, bxdf: &Bxdf, uv: Vec2) -> Bxdf {
+        let mut b = match &self.reflectance {
+            Some(t) => bxdf.with_reflectance(t.eval(uv)),
+            None => bxdf.clone(),
+        };
+        if let Some(r) = &self.roughness {
+            b.set_roughness(r.eval(uv).max(SMOOTH_ALPHA));
+        }
+        if let Some(t) = &self.thickness_nm {
+            b.set_thickness_nm(t.eval(uv));
+        }
+        b
+    }
+}
+
 /// The reflectance at field `field`: a [`Texture`] for `Image` and
 /// `Checkerboard`, else `None` (the caller builds the constant spectrum).
 pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
+    texture_as(check, field, d, Role::Reflectance)
+}
+
+/// The emitted radiance at field `field` (an object's `emission`), as
+/// [`from_desc`]: each colour uplifted as `Rgb(...)` emission is.
+pub(crate) fn emission_from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<Option<Texture>> {
+    texture_as(check, field, d, Role::Emission)
+}
+
+fn texture_as(check: &Check, field: &str, d: &SpectrumDesc, role: Role) -> Result<Option<Texture>> {
+    let spectrum = |name: &str, s: &SpectrumDesc| match role {
+        Role::Reflectance => check.reflectance(&format!("{field}.{name}"), s),
+        Role::Emission => check.spectrum(&format!("{field}.{name}"), s),
+    };
     Ok(Some(match d {
         SpectrumDesc::Checkerboard { even, odd, scale } => Texture::Checkerboard {
-            even: Box::new(check.reflectance(&format!("{field}.even"), even)?),
-            odd: Box::new(check.reflectance(&format!("{field}.odd"), odd)?),
+            even: Box::new(spectrum("even", even)?),
+            odd: Box::new(spectrum("odd", odd)?),
             scale: check.positive(&format!("{field}.scale"), *scale)?,
         },
         SpectrumDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
             let path_field = format!("{field}.path");
             let scale = check.positive(&format!("{field}.scale"), *scale)?;
-            let finite2 = |name: &str, v: [f32; 2]| {
-                if v.iter().all(|c| c.is_finite()) {
-                    Ok(Vec2::from(v))
-                } else {
-                    Err(check.err(format!("{field}.{name}"), format!("expected finite numbers, found {v:?}")))
-                }
-            };
-            let (uv_scale, uv_offset) = (finite2("uv_scale", *uv_scale)?, finite2("uv_offset", *uv_offset)?);
+            let (uv_scale, uv_offset) =
+                (finite2(check, field, "uv_scale", *uv_scale)?, finite2(check, field, "uv_offset", *uv_offset)?);
             let (resolved, bytes) = check.read_input(&path_field, path)?;
             let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
             let rgb = pixels.linear_rgb();
-            let image = ImageTexture::new(w as usize, h as usize, &rgb, scale, uv_scale, uv_offset, *wrap)
+            let image = ImageTexture::new(w as usize, h as usize, &rgb, scale, uv_scale, uv_offset, *wrap, role)
                 .map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
             Texture::Image(Arc::new(image))
         }
@@ -178,12 +456,65 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &SpectrumDesc) -> Result<
     }))
 }
 
+/// The texture of a scalar at field `field` (`materials."m".roughness`),
+/// every value in `[lo, hi]`; `what` names the quantity in errors (a GGX
+/// alpha, a thickness in nm).
+pub(crate) fn scalar_from_desc(
+    check: &Check,
+    field: &str,
+    d: &ScalarTextureDesc,
+    (lo, hi): (f32, f32),
+    what: &str,
+) -> Result<ScalarTexture> {
+    let in_range = |name: &str, v: f32| {
+        if (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(check.err(format!("{field}.{name}"), format!("expected {what} in [{lo}, {hi}], found {v}")))
+        }
+    };
+    Ok(match d {
+        ScalarTextureDesc::Checkerboard { even, odd, scale } => ScalarTexture::Checkerboard {
+            even: in_range("even", *even)?,
+            odd: in_range("odd", *odd)?,
+            scale: check.positive(&format!("{field}.scale"), *scale)?,
+        },
+        ScalarTextureDesc::Image { path, uv_scale, uv_offset, wrap, scale } => {
+            let path_field = format!("{field}.path");
+            let scale = check.positive(&format!("{field}.scale"), *scale)?;
+            let (uv_scale, uv_offset) =
+                (finite2(check, field, "uv_scale", *uv_scale)?, finite2(check, field, "uv_offset", *uv_offset)?);
+            let (resolved, bytes) = check.read_input(&path_field, path)?;
+            let (w, h, pixels) = decode_image(&resolved, &bytes).map_err(|e| check.err(&path_field, e.to_string()))?;
+            let image =
+                ScalarImage::new(w as usize, h as usize, &pixels.linear_rgb(), scale, uv_scale, uv_offset, *wrap)
+                    .map_err(|m| check.err(&path_field, format!("{path}: {m}")))?;
+            if let Some((x, y, v)) = image.outside(lo, hi) {
+                return Err(check.err(
+                    &path_field,
+                    format!("{path}: texel ({x}, {y}) times the scale is {v}; expected {what} in [{lo}, {hi}]"),
+                ));
+            }
+            ScalarTexture::Image(Arc::new(image))
+        }
+    })
+}
+
+/// A pair of finite numbers at `field.name`.
+fn finite2(check: &Check, field: &str, name: &str, v: [f32; 2]) -> Result<Vec2> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(Vec2::from(v))
+    } else {
+        Err(check.err(format!("{field}.{name}"), format!("expected finite numbers, found {v:?}")))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn image(w: usize, h: usize, rgb: &[[f32; 3]], wrap: Wrap) -> ImageTexture {
-        ImageTexture::new(w, h, rgb, 1.0, Vec2::ONE, Vec2::ZERO, wrap).unwrap()
+        ImageTexture::new(w, h, rgb, 1.0, Vec2::ONE, Vec2::ZERO, wrap, Role::Reflectance).unwrap()
     }
 
     /// Bilinear weights: at a texel's centre the texel itself; halfway between

@@ -252,7 +252,8 @@ fn scene_format_covers_every_variant_and_field_of_desc() {
     let ron: String = ron_blocks(&md).into_iter().map(|b| b.text).collect::<Vec<_>>().join("\n");
     let words: BTreeSet<String> =
         ron.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).map(str::to_string).collect();
-    // ScaleDesc is untagged: its variants are never written (`scale: 0.5` or `(x, y, z)`).
+    // ScaleDesc and ScalarDesc are untagged: their variants are never written (`scale: 0.5`
+    // or `(x, y, z)`; `roughness: 0.2` or a texture).
     // desc.rs and its parts in src/scene/desc/, in name order.
     let mut parts: Vec<_> = std::fs::read_dir(root().join("src/scene/desc"))
         .expect("src/scene/desc/")
@@ -261,7 +262,7 @@ fn scene_format_covers_every_variant_and_field_of_desc() {
         .collect();
     parts.sort();
     let desc = std::iter::once(root().join("src/scene/desc.rs")).chain(parts).map(|p| read(&p)).collect::<Vec<_>>();
-    let (variants, fields) = desc_names(&desc.join("\n"), &["ScaleDesc"]);
+    let (variants, fields) = desc_names(&desc.join("\n"), &["ScaleDesc", "ScalarDesc"]);
     assert!(variants.len() >= 30 && fields.len() >= 30, "desc.rs parsed badly: {variants:?} {fields:?}");
     let settings_src = read(&root().join("src/settings.rs"));
     let start = settings_src.find("\nsettings! {").expect("the settings! invocation in src/settings.rs");

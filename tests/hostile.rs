@@ -1095,6 +1095,148 @@ fn bad_textures_are_one_error_and_odd_ones_render() {
     }
 }
 
+/// Bad emission textures (issue 35) are one error line naming the object's
+/// `emission` field and what was expected: a missing or truncated image, a
+/// NaN or negative texel, a scale that is not positive, a square that is not
+/// an emission, a texture inside a checkerboard; a 1x1 emission image on
+/// every emitting shape renders.
+#[test]
+fn bad_emission_textures_are_one_error_naming_the_field() {
+    let dir = temp_dir("hostile_emission_textures");
+    image::Rgb32FImage::from_raw(2, 1, vec![0.5, f32::NAN, 0.5, 0.5, 0.5, 0.5])
+        .unwrap()
+        .save(dir.join("nan.exr"))
+        .unwrap();
+    image::Rgb32FImage::from_raw(2, 1, vec![0.5, 0.5, 0.5, 0.5, -0.1, 0.5])
+        .unwrap()
+        .save(dir.join("negative.exr"))
+        .unwrap();
+    image::Rgb32FImage::from_raw(1, 1, vec![3e38, 1.0, 1.0]).unwrap().save(dir.join("huge.exr")).unwrap();
+    image::RgbImage::from_raw(1, 1, vec![200, 100, 50]).unwrap().save(dir.join("one.png")).unwrap();
+    let png = std::fs::read(dir.join("one.png")).unwrap();
+    std::fs::write(dir.join("truncated.png"), &png[..png.len() / 2]).unwrap();
+    let scene = |shape: &str, emission: &str| {
+        format!(
+            r#"(camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40), render: (width: 8, height: 8, spp: 2),
+            materials: {{ "m": Lambertian(reflectance: Constant(0.5)) }},
+            objects: [
+                (shape: Quad(origin: (-2, -1, 2), edge_u: (4, 0, 0), edge_v: (0, 0, -4)), material: "m"),
+                (shape: {shape}, emission: {emission}),
+            ])"#
+        )
+    };
+    let quad = "Quad(origin: (-0.5, 1, -0.5), edge_u: (1, 0, 0), edge_v: (0, 0, 1))";
+    let out = dir.join("out.png");
+    for (emission, at, what) in [
+        (r#"Image(path: "missing.png")"#, "emission.path", "missing.png"),
+        (r#"Image(path: "truncated.png")"#, "emission.path", "decode"),
+        (r#"Image(path: "nan.exr")"#, "emission.path", "texel (0, 0) is not a finite colour"),
+        (r#"Image(path: "negative.exr")"#, "emission.path", "texel (1, 0) is negative"),
+        (r#"Image(path: "huge.exr", scale: 1e10)"#, "emission.path", "not finite"),
+        (r#"Image(path: "one.png", scale: 0)"#, "emission.scale", "positive"),
+        (r#"Image(path: "one.png", scale: inf)"#, "emission.scale", "positive"),
+        (r#"Image(path: "one.png", uv_offset: (inf, 0))"#, "emission.uv_offset", "finite"),
+        ("Checkerboard(even: Constant(-1), odd: Constant(1), scale: 4)", "emission.even", "non-negative"),
+        ("Checkerboard(even: Constant(1), odd: Constant(1), scale: 0)", "emission.scale", "positive"),
+        (r#"Checkerboard(even: Image(path: "one.png"), odd: Constant(1), scale: 2)"#, "emission.even", "texture"),
+    ] {
+        let p = scene_in(&dir, &scene(quad, emission));
+        let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+        assert!(e.contains("objects[1].") && e.contains(at) && e.contains(what), "{emission}: {e}");
+    }
+    // Valid: a 1x1 image and a checkerboard on every emitting shape.
+    std::fs::write(dir.join("tri.obj"), TRI_OBJ).unwrap();
+    for shape in [
+        quad,
+        "Sphere(center: (0, 0.5, 0), radius: 0.3)",
+        "Disk(center: (0, 1, 0), normal: (0, -1, 0), radius: 0.4)",
+        "Cuboid(min: (-0.2, 0.8, -0.2), max: (0.2, 1, 0.2))",
+        r#"Mesh(path: "tri.obj")"#,
+    ] {
+        for emission in [r#"Image(path: "one.png", scale: 3)"#, "Checkerboard(even: Rgb(2, 1, 0), odd: D65, scale: 3)"]
+        {
+            let p = scene_in(&dir, &scene(shape, emission));
+            let o = run(&["render", s(&p), "-o", s(&out), "--integrator", "bdpt"]);
+            assert!(o.status.success(), "{shape} {emission}: {}", stderr(&o));
+        }
+    }
+}
+
+/// Bad scalar textures (issue 35: `roughness`, `thickness_nm`) are one error
+/// line naming the field and what was expected: a NaN or negative texel in a
+/// roughness map, a map above α 1 once scaled, a negative thickness, a
+/// spectrum where a number stands, a misspelt texture or field (the RON
+/// position and the three accepted forms); a plain number parses as before.
+#[test]
+fn bad_scalar_textures_are_one_error_naming_the_field() {
+    let dir = temp_dir("hostile_scalar_textures");
+    image::Rgb32FImage::from_raw(2, 1, vec![0.5, f32::NAN, 0.5, 0.5, 0.5, 0.5])
+        .unwrap()
+        .save(dir.join("nan.exr"))
+        .unwrap();
+    image::Rgb32FImage::from_raw(2, 1, vec![0.5, 0.5, 0.5, -0.1, -0.1, -0.1])
+        .unwrap()
+        .save(dir.join("negative.exr"))
+        .unwrap();
+    image::RgbImage::from_raw(1, 1, vec![200, 200, 200]).unwrap().save(dir.join("grey.png")).unwrap();
+    let png = std::fs::read(dir.join("grey.png")).unwrap();
+    std::fs::write(dir.join("truncated.png"), &png[..png.len() / 2]).unwrap();
+    let scene = |material: &str| {
+        format!(
+            r#"(camera: (eye: (0, 0, 3), look_at: (0, 0, 0), fov_deg: 40), render: (width: 8, height: 8, spp: 2),
+            materials: {{ "m": {material} }},
+            objects: [
+                (shape: Sphere(center: (0, 0, 0), radius: 1), material: "m"),
+                (shape: Sphere(center: (0, 3, 0), radius: 0.5), emission: Constant(5)),
+            ])"#
+        )
+    };
+    let out = dir.join("out.png");
+    let metal = |r: &str| format!(r#"Conductor(metal: "Au", roughness: {r})"#);
+    let sheet = |t: &str| format!("ThinSheet(thickness_nm: {t}, ior: Constant(1.33))");
+    for (material, field, what) in [
+        (metal(r#"Image(path: "nan.exr")"#), "materials.\"m\".roughness.path", "texel (0, 0) is not a finite"),
+        (metal(r#"Image(path: "negative.exr")"#), "materials.\"m\".roughness.path", "texel (1, 0) times the scale is -0.1"),
+        (metal(r#"Image(path: "grey.png", scale: 3)"#), "materials.\"m\".roughness.path", "a GGX alpha in [0, 1]"),
+        (metal(r#"Image(path: "missing.png")"#), "materials.\"m\".roughness.path", "missing.png"),
+        (metal(r#"Image(path: "truncated.png")"#), "materials.\"m\".roughness.path", "decode"),
+        (metal(r#"Image(path: "grey.png", scale: 0)"#), "materials.\"m\".roughness.scale", "positive"),
+        (metal("Checkerboard(even: 0.1, odd: 1.5, scale: 2)"), "materials.\"m\".roughness.odd", "a GGX alpha in [0, 1]"),
+        (metal("Checkerboard(even: NaN, odd: 0.5, scale: 2)"), "materials.\"m\".roughness.even", "found NaN"),
+        (metal("Checkerboard(even: 0.1, odd: 0.5, scale: -2)"), "materials.\"m\".roughness.scale", "positive"),
+        (metal("-0.1"), "materials.\"m\".roughness", "a GGX alpha in [0, 1], found -0.1"),
+        (sheet("Checkerboard(even: -5, odd: 300, scale: 2)"), "materials.\"m\".thickness_nm.even", "a thickness in nm"),
+        (sheet("-5"), "materials.\"m\".thickness_nm", "a thickness in nm"),
+        (
+            r#"Dielectric(ior: Constant(1.5), coating: ThinFilm(thickness_nm: Image(path: "negative.exr", scale: 100), ior: Constant(1.38)))"#.to_string(),
+            "materials.\"m\".coating.thickness_nm.path",
+            "a thickness in nm",
+        ),
+        // What serde sees: the position and the three accepted forms.
+        (metal(r#"Imag(path: "grey.png")"#), ":", "expected a number (`roughness: 0.2`), `Image(path:"),
+        (metal(r#"Image(pth: "grey.png")"#), ":", "or `Checkerboard(even: 0.1, odd: 0.4, scale: 8)`"),
+        (metal("Checkerboard(even: Constant(0.1), odd: 0.4, scale: 2)"), ":", "(numbers, not spectra)"),
+        (metal("\"0.2\""), ":", "expected a number"),
+    ] {
+        let p = scene_in(&dir, &scene(&material));
+        let e = one_error(&run(&["render", s(&p), "-o", s(&out)]), 1);
+        assert!(e.contains(field) && e.contains(what), "{material}: {e}");
+    }
+    // Valid: a number as before, and textures on every material that takes one.
+    for material in [
+        metal("0.2"),
+        metal("0"),
+        metal(r#"Image(path: "grey.png", scale: 0.5, wrap: Clamp)"#),
+        r#"Plastic(reflectance: Constant(0.5), ior: Constant(1.5), roughness: Checkerboard(even: 0, odd: 1, scale: 4))"#
+            .to_string(),
+        sheet(r#"Image(path: "grey.png", scale: 500)"#),
+    ] {
+        let p = scene_in(&dir, &scene(&material));
+        let o = run(&["render", s(&p), "-o", s(&out)]);
+        assert!(o.status.success(), "{material}: {}", stderr(&o));
+    }
+}
+
 /// Bad media: one error line naming the field.
 #[test]
 fn bad_media_are_one_error_naming_the_field() {

@@ -30,3 +30,4 @@ mod spectra;
 mod spectral;
 mod stability;
 mod surround;
+mod textures;

@@ -137,6 +137,19 @@ impl Dielectric {
         self
     }
 
+    /// Sets the GGX α of the interface (a roughness texture's value at a hit).
+    pub fn set_roughness(&mut self, alpha: f32) {
+        self.alpha = alpha;
+    }
+
+    /// Sets the coating's thickness (a texture's value at a hit; nothing
+    /// without a coating).
+    pub fn set_coating_thickness_nm(&mut self, nm: f32) {
+        if let Some(film) = &mut self.coating {
+            film.thickness_nm = nm;
+        }
+    }
+
     /// The same glass under a thin film: its reflectance (every microfacet's,
     /// on rough glass) becomes the film's Airy reflectance per wavelength.
     pub fn with_coating(mut self, film: ThinFilm) -> Self {

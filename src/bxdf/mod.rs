@@ -120,6 +120,33 @@ impl Bxdf {
         }
     }
 
+    /// Sets the GGX α of the models with one (Conductor, Dielectric,
+    /// Plastic: a roughness texture's value at a hit); others unchanged.
+    pub fn set_roughness(&mut self, alpha: f32) {
+        match self {
+            Bxdf::Conductor(c) => c.alpha = alpha,
+            Bxdf::Dielectric(d) => d.set_roughness(alpha),
+            Bxdf::Plastic(p) => p.set_roughness(alpha),
+            _ => {}
+        }
+    }
+
+    /// Sets the thickness of the thin film of the models with one (a
+    /// `ThinFilm` coating on a Conductor or Dielectric, a ThinSheet: a
+    /// thickness texture's value at a hit); others unchanged.
+    pub fn set_thickness_nm(&mut self, nm: f32) {
+        match self {
+            Bxdf::Conductor(c) => {
+                if let Some(film) = &mut c.coating {
+                    film.thickness_nm = nm;
+                }
+            }
+            Bxdf::Dielectric(d) => d.set_coating_thickness_nm(nm),
+            Bxdf::ThinSheet(s) => s.film.thickness_nm = nm,
+            _ => {}
+        }
+    }
+
     /// `f(wo, wi)` for the packet (zero for delta models).
     #[inline]
     pub fn eval<const N: usize>(&self, wo: Vec3, wi: Vec3, lambdas: &Lambdas<N>) -> Sampled<N> {

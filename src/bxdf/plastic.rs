@@ -74,6 +74,11 @@ impl Plastic {
         Plastic { reflectance, eta, diffuse, f_dr_out, alpha }
     }
 
+    /// Sets the coat's GGX α (a roughness texture's value at a hit).
+    pub fn set_roughness(&mut self, alpha: f32) {
+        self.alpha = alpha;
+    }
+
     /// The same coat over another base reflectance (a texture's value at a hit).
     pub fn with_reflectance(&self, reflectance: Spectrum) -> Self {
         let diffuse = Self::diffuse_scale(&reflectance, &self.eta, &self.f_dr_out);

@@ -513,7 +513,7 @@ pub(crate) fn sample_direct<const N: usize>(
     } else {
         power_heuristic(pdf_light, bxdf.pdf_within(sh.wo, wi_local, lambdas, outside))
     };
-    let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
+    let le = scene.with_radiance(choice.light, ls.wi, choice.uv, |s| lambdas.sample(s));
     f * le * (ls.scale * wi_local.z.abs() * weight / pdf_light)
 }
 
@@ -553,7 +553,7 @@ pub(crate) fn sample_direct_medium<const N: usize>(
     clear.attenuate(&mut t, lambdas);
     let pdf_light = choice.pmf * ls.pdf;
     let weight = if ls.is_delta { 1.0 } else { power_heuristic(pdf_light, f) };
-    let le = scene.light(choice.light).with_radiance(ls.wi, |s| lambdas.sample(s));
+    let le = scene.with_radiance(choice.light, ls.wi, choice.uv, |s| lambdas.sample(s));
     t * le * (ls.scale * weight / pdf_light)
 }
 

@@ -176,7 +176,8 @@ impl PathTracer {
                 }
             }
             // 1. Emission, MIS-weighted against the light sample taken at the previous vertex.
-            if add_emission && let Some(e) = scene.le(&si, ray.dir) {
+            let mut emitted = None;
+            if add_emission && let Some(e) = scene.le(&si, ray.dir, &mut emitted) {
                 let weight = if w.prev.delta {
                     1.0
                 } else {

@@ -58,7 +58,8 @@ impl Whitted {
                 beta *= medium.transmittance(hit.t, lambdas);
             }
             // Emitters seen directly or through specular surfaces only.
-            if let Some(e) = scene.le(&si, ray.dir) {
+            let mut emitted = None;
+            if let Some(e) = scene.le(&si, ray.dir, &mut emitted) {
                 l += beta * lambdas.sample(e.radiance) * e.scale;
             }
             // Nested dielectrics: a false intersection goes straight on.

@@ -19,7 +19,7 @@ use std::f32::consts::PI;
 
 use super::EmissionSample;
 use super::emit::{surface_pdf_dir, surface_ray};
-use super::{LightSample, sides};
+use super::{EmissionTexture, LightSample, mean_radiance, sides};
 use crate::color::Spectrum;
 use crate::shape::{Cuboid, Mesh, Quad};
 
@@ -28,8 +28,9 @@ use crate::shape::{Cuboid, Mesh, Quad};
 enum Patch {
     /// `origin + a u + b v`, `a, b` in [0, 1].
     Parallelogram { origin: Vec3, u: Vec3, v: Vec3, n: Vec3 },
-    /// `p0 + b1 e1 + b2 e2`, `b1, b2 >= 0`, `b1 + b2 <= 1`.
-    Triangle { p0: Vec3, e1: Vec3, e2: Vec3, n: Vec3 },
+    /// `p0 + b1 e1 + b2 e2`, `b1, b2 >= 0`, `b1 + b2 <= 1`; triangle `prim`
+    /// of its mesh (for its texture coordinates).
+    Triangle { p0: Vec3, e1: Vec3, e2: Vec3, n: Vec3, prim: u32 },
 }
 
 impl Patch {
@@ -40,31 +41,39 @@ impl Patch {
         }
     }
 
-    /// A point uniformly on the patch, and the patch's normal.
-    fn sample(&self, u: Vec2) -> (Vec3, Vec3) {
+    /// A point uniformly on the patch, the patch's normal, and the point's
+    /// coordinates on the patch (`(a, b)` on a parallelogram, the
+    /// barycentrics `(b1, b2)` on a triangle).
+    #[inline]
+    fn sample(&self, u: Vec2) -> (Vec3, Vec3, Vec2) {
         match *self {
-            Patch::Parallelogram { origin, u: eu, v: ev, n } => (origin + eu * u.x + ev * u.y, n),
-            Patch::Triangle { p0, e1, e2, n } => {
+            Patch::Parallelogram { origin, u: eu, v: ev, n } => (origin + eu * u.x + ev * u.y, n, u),
+            Patch::Triangle { p0, e1, e2, n, .. } => {
                 // Uniform barycentrics (pbrt-v4 §6.5.4's square-root warp).
                 let s = u.x.sqrt();
                 let (b1, b2) = (1.0 - s, u.y * s);
-                (p0 + e1 * b1 + e2 * b2, n)
+                (p0 + e1 * b1 + e2 * b2, n, Vec2::new(b1, b2))
             }
         }
     }
 }
 
-/// A quad, cuboid or mesh emitting `radiance` uniformly.
+/// A quad, cuboid or mesh emitting `radiance` uniformly, or a texture of radiance.
 #[derive(Clone, Debug)]
 pub struct AreaLight {
     patches: Vec<Patch>,
     /// Cumulative patch areas divided by the total.
     cdf: Vec<f32>,
     area: f32,
-    /// Emitted radiance per wavelength.
+    /// Emitted radiance per wavelength (with a texture, its per-bin peak).
     pub radiance: Spectrum,
     /// Emits from both sides.
     pub two_sided: bool,
+    /// The radiance over the surface's (u, v), when it varies.
+    pub texture: Option<Box<EmissionTexture>>,
+    /// With a texture on a mesh, each patch's texture coordinates at its three
+    /// corners (`p0`, `p0 + e1`, `p0 + e2`); else empty.
+    uvs: Vec<[Vec2; 3]>,
 }
 
 impl AreaLight {
@@ -85,7 +94,41 @@ impl AreaLight {
         for c in &mut cdf {
             *c /= area;
         }
-        Some(AreaLight { patches, cdf, area, radiance, two_sided })
+        Some(AreaLight { patches, cdf, area, radiance, two_sided, texture: None, uvs: Vec::new() })
+    }
+
+    /// This light with its radiance given by `texture` at each point's (u, v)
+    /// (the quad's or cuboid face's `(a, b)`, the mesh's texture coordinates
+    /// as [`crate::shape::Shape::uv`] gives them: `mesh` is the emitting mesh).
+    pub fn with_texture(mut self, texture: Option<Box<EmissionTexture>>, mesh: Option<&Mesh>) -> AreaLight {
+        if texture.is_some()
+            && let Some(m) = mesh
+        {
+            self.uvs = self
+                .patches
+                .iter()
+                .map(|p| match *p {
+                    Patch::Triangle { prim, .. } => {
+                        [m.uv(prim, 0.0, 0.0), m.uv(prim, 1.0, 0.0), m.uv(prim, 0.0, 1.0)].map(Vec2::from)
+                    }
+                    Patch::Parallelogram { .. } => [Vec2::ZERO, Vec2::X, Vec2::Y],
+                })
+                .collect();
+        }
+        self.texture = texture;
+        self
+    }
+
+    /// The (u, v) of the point at coordinates `b` on patch `k` (see [`Patch::sample`]).
+    #[inline(never)]
+    fn uv(&self, k: usize, b: Vec2) -> Vec2 {
+        match self.patches[k] {
+            Patch::Parallelogram { .. } => b,
+            Patch::Triangle { .. } => match self.uvs.get(k) {
+                Some([t0, t1, t2]) => *t0 * (1.0 - b.x - b.y) + *t1 * b.x + *t2 * b.y,
+                None => Vec2::ZERO,
+            },
+        }
     }
 
     /// A quad emitting to the side of `edge_u × edge_v`.
@@ -116,15 +159,16 @@ impl AreaLight {
             .map(|k| {
                 let [p0, p1, p2] = m.triangle(k);
                 let (e1, e2) = (p1 - p0, p2 - p0);
-                Patch::Triangle { p0, e1, e2, n: e1.cross(e2).normalize_or_zero() }
+                Patch::Triangle { p0, e1, e2, n: e1.cross(e2).normalize_or_zero(), prim: k }
             })
             .collect();
         AreaLight::new(patches, radiance, two_sided)
     }
 
-    /// Total power up to the spectrum's shape: `π A` times the mean radiance per side.
+    /// Total power up to the spectrum's shape: `π A` times the mean radiance
+    /// per side (a texture's mean, [`EmissionTexture::mean`]).
     pub fn power(&self) -> f32 {
-        sides(self.two_sided) * PI * self.area * self.radiance.average()
+        sides(self.two_sided) * PI * self.area * mean_radiance(&self.radiance, &self.texture)
     }
 
     /// The cosine at the light of a direction `wi` arriving at a patch of
@@ -134,14 +178,17 @@ impl AreaLight {
         if self.two_sided { wi.dot(n).abs() } else { -wi.dot(n) }
     }
 
-    /// A point uniformly by area and its geometric normal.
+    /// A point uniformly by area, its geometric normal, and its (u, v) when
+    /// the light has a texture (else zero).
     #[inline]
-    pub(super) fn sample_point(&self, u: Vec2) -> (Vec3, Vec3) {
+    pub(super) fn sample_point(&self, u: Vec2) -> (Vec3, Vec3, Vec2) {
         // Choose a patch with u.x, then reuse u.x's position within its interval.
         let k = self.cdf.partition_point(|&c| c <= u.x).min(self.patches.len() - 1);
         let lo = if k == 0 { 0.0 } else { self.cdf[k - 1] };
         let ux = ((u.x - lo) / (self.cdf[k] - lo)).clamp(0.0, 1.0 - f32::EPSILON);
-        self.patches[k].sample(Vec2::new(ux, u.y))
+        let (point, n, b) = self.patches[k].sample(Vec2::new(ux, u.y));
+        let uv = if self.texture.is_some() { self.uv(k, b) } else { Vec2::ZERO };
+        (point, n, uv)
     }
 
     /// The total area of the emitting surface.
@@ -153,7 +200,14 @@ impl AreaLight {
     /// Samples a point uniformly by area; the pdf is per solid angle from `p`.
     #[inline]
     pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
-        let (point, n) = self.sample_point(u);
+        self.sample_li_uv(p, u).map(|(s, _)| s)
+    }
+
+    /// [`AreaLight::sample_li`], and the sampled point's (u, v) when the light
+    /// has a texture (else zero).
+    #[inline]
+    pub fn sample_li_uv(&self, p: Vec3, u: Vec2) -> Option<(LightSample, Vec2)> {
+        let (point, n, uv) = self.sample_point(u);
         let d = point - p;
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -164,7 +218,7 @@ impl AreaLight {
         if cos_l <= 0.0 {
             return None;
         }
-        Some(LightSample { wi, point, n, pdf: d2 / (cos_l * self.area), scale: 1.0, is_delta: false })
+        Some((LightSample { wi, point, n, pdf: d2 / (cos_l * self.area), scale: 1.0, is_delta: false }, uv))
     }
 
     /// The pdf per solid angle of [`AreaLight::sample_li`] from `p` for `wi`
@@ -184,8 +238,8 @@ impl AreaLight {
     /// A cosine-distributed ray from a point drawn uniformly by area.
     #[inline]
     pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
-        let (point, n) = self.sample_point(u_pos);
-        surface_ray(point, n, self.area(), self.two_sided, u_dir)
+        let (point, n, uv) = self.sample_point(u_pos);
+        surface_ray(point, n, uv, self.area(), self.two_sided, u_dir)
     }
 
     /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].

@@ -11,11 +11,12 @@ use std::f32::consts::PI;
 
 use super::EmissionSample;
 use super::emit::{surface_pdf_dir, surface_ray};
-use super::{LightSample, sides};
+use super::{EmissionTexture, LightSample, mean_radiance, sides};
 use crate::color::Spectrum;
 use crate::geometry::Frame;
+use crate::geometry::Hit;
 use crate::sampler::warp::concentric_disk;
-use crate::shape::Disk;
+use crate::shape::{Disk, Shape};
 
 /// A disk light emitting `radiance` to the side its normal points to (both when two-sided).
 #[derive(Clone, Debug)]
@@ -26,13 +27,16 @@ pub struct DiskLight {
     pub radiance: Spectrum,
     /// Emits from both sides.
     pub two_sided: bool,
+    /// The radiance over the surface's (u, v) when it varies (then
+    /// `radiance` is its per-bin peak).
+    pub texture: Option<Box<EmissionTexture>>,
 }
 
 impl DiskLight {
     /// Total power up to the spectrum's shape: `π A` times the mean radiance per side.
     pub fn power(&self) -> f32 {
         let r = self.disk.radius;
-        sides(self.two_sided) * PI * PI * r * r * self.radiance.average()
+        sides(self.two_sided) * PI * PI * r * r * mean_radiance(&self.radiance, &self.texture)
     }
 
     /// Samples a point on the disk uniformly by area; the pdf is per solid angle from `p`.
@@ -83,7 +87,16 @@ impl DiskLight {
         let q = concentric_disk(u_pos) * self.disk.radius;
         let point = self.disk.center + Frame::from_z(self.disk.normal).to_world(Vec3::new(q.x, q.y, 0.0));
         let area = PI * self.disk.radius * self.disk.radius;
-        surface_ray(point, self.disk.normal, area, self.two_sided, u_dir)
+        surface_ray(point, self.disk.normal, self.uv(point), area, self.two_sided, u_dir)
+    }
+
+    /// The (u, v) of `point` on the disk when the light has a texture (else zero).
+    #[inline]
+    pub(super) fn uv(&self, point: Vec3) -> Vec2 {
+        match self.texture {
+            Some(_) => Shape::Disk(self.disk).uv(&Hit::flat(0.0, point, self.disk.normal)),
+            None => Vec2::ZERO,
+        }
     }
 
     /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].

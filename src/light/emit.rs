@@ -42,8 +42,11 @@ pub struct EmissionSample {
     pub pdf_pos: f32,
     /// The density of `dir` per unit solid angle (1 for a delta direction).
     pub pdf_dir: f32,
-    /// The emitted quantity along the ray as a factor of [`Light::spectrum`].
+    /// The emitted quantity along the ray as a factor of [`Light::spectrum`]
+    /// (of the texture at `uv` for a textured emitter: [`Light::with_radiance`]).
     pub scale: f32,
+    /// The point's surface coordinates on a textured emitter (else zero).
+    pub uv: Vec2,
 }
 
 impl Light {
@@ -114,9 +117,17 @@ impl Light {
     }
 }
 
-/// A cosine-distributed ray from a point of an area light.
+/// A cosine-distributed ray from a point of an area light (of surface
+/// coordinates `uv` on a textured light, else zero).
 #[inline]
-pub(super) fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: Vec2) -> Option<EmissionSample> {
+pub(super) fn surface_ray(
+    point: Vec3,
+    n: Vec3,
+    uv: Vec2,
+    area: f32,
+    two_sided: bool,
+    u: Vec2,
+) -> Option<EmissionSample> {
     if area.is_nan() || area <= 0.0 {
         return None;
     }
@@ -132,7 +143,7 @@ pub(super) fn surface_ray(point: Vec3, n: Vec3, area: f32, two_sided: bool, u: V
         return None;
     }
     let dir = Frame::from_z(side).to_world(local).normalize();
-    Some(EmissionSample { point, n, dir, pdf_pos: 1.0 / area, pdf_dir: pick * local.z / PI, scale: 1.0 })
+    Some(EmissionSample { point, n, dir, pdf_pos: 1.0 / area, pdf_dir: pick * local.z / PI, scale: 1.0, uv })
 }
 
 /// The direction density of [`surface_ray`].
@@ -156,7 +167,7 @@ pub(super) fn parallel_ray(center: Vec3, dir: Vec3, r: f32, u: Vec2) -> Option<E
     }
     let q = concentric_disk(u) * r;
     let point = center + Frame::from_z(dir).to_world(Vec3::new(q.x, q.y, 0.0));
-    Some(EmissionSample { point, n: dir, dir, pdf_pos: 1.0 / (PI * r * r), pdf_dir: 1.0, scale: 1.0 })
+    Some(EmissionSample { point, n: dir, dir, pdf_pos: 1.0 / (PI * r * r), pdf_dir: 1.0, scale: 1.0, uv: Vec2::ZERO })
 }
 
 #[cfg(test)]
@@ -183,11 +194,13 @@ mod tests {
                 sphere: Sphere::new(Vec3::ZERO, 0.3),
                 radiance: Spectrum::ONE,
                 two_sided: false,
+                texture: None,
             }),
             Light::Disk(DiskLight {
                 disk: Disk { center: Vec3::Y, normal: Vec3::NEG_Y, radius: 0.5 },
                 radiance: Spectrum::ONE,
                 two_sided: true,
+                texture: None,
             }),
             Light::Beam(BeamLight { origin: Vec3::ZERO, direction: Vec3::X, radius: 0.2, irradiance: Spectrum::ONE }),
         ];
@@ -268,6 +281,7 @@ mod tests {
                     sphere: Sphere::new(Vec3::ZERO, 0.3),
                     radiance: spectrum,
                     two_sided: false,
+                    texture: None,
                 }),
                 PI64 * (4.0 * PI64 * 0.09) * l,
             ),
@@ -277,6 +291,7 @@ mod tests {
                     disk: Disk { center: Vec3::Y, normal: Vec3::NEG_Y, radius: 0.5 },
                     radiance: spectrum,
                     two_sided: true,
+                    texture: None,
                 }),
                 2.0 * PI64 * (PI64 * 0.25) * l,
             ),
@@ -286,6 +301,7 @@ mod tests {
                     disk: Disk { center: Vec3::Y, normal: Vec3::NEG_Y, radius: 0.5 },
                     radiance: spectrum,
                     two_sided: false,
+                    texture: None,
                 }),
                 PI64 * (PI64 * 0.25) * l,
             ),

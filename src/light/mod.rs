@@ -50,6 +50,30 @@ use crate::error::Result;
 use crate::scene::check::Check;
 use crate::scene::desc::{LightDesc, SpectrumDesc};
 use crate::shape::Shape;
+use crate::texture::Texture;
+
+/// An area light's radiance where it varies over the surface: an object's
+/// `emission:` given as an `Image` or a `Checkerboard` (see `crate::texture`),
+/// looked up at the (u, v) of each point of the emitter ([`crate::shape::Shape::uv`]).
+#[derive(Clone, Debug)]
+pub struct EmissionTexture {
+    /// The radiance at each (u, v).
+    pub texture: Texture,
+    /// Its mean over the texture ([`Texture::mean_and_peak`]): the light's
+    /// power for choosing among lights. Any positive power keeps the choice
+    /// unbiased; the points on the light are still drawn uniformly by area.
+    pub mean: Spectrum,
+}
+
+/// The mean radiance (over bins and, with a texture, over the surface) of an
+/// area light of constant `radiance` or of `texture`.
+#[inline]
+fn mean_radiance(radiance: &Spectrum, texture: &Option<Box<EmissionTexture>>) -> f32 {
+    match texture {
+        Some(t) => t.mean.average(),
+        None => radiance.average(),
+    }
+}
 
 /// The closed set of lights.
 #[derive(Clone, Debug)]
@@ -94,8 +118,9 @@ pub struct LightSample {
 impl Light {
     /// The spectrum emitted: radiance for area lights, intensity for point
     /// and spot lights, irradiance for distant lights and beams; for the
-    /// environment, whose radiance varies with direction, the per-bin peak
-    /// (for warnings only: a sample's radiance is [`Light::with_radiance`]).
+    /// environment, whose radiance varies with direction, and a textured area
+    /// light, whose radiance varies over its surface, the per-bin peak (for
+    /// warnings only: a sample's radiance is [`Light::with_radiance`]).
     #[inline]
     pub fn spectrum(&self) -> &Spectrum {
         match self {
@@ -111,16 +136,53 @@ impl Light {
     }
 
     /// `f` of what arrives from the light along the sampled direction `wi`
-    /// (from the shading point towards the light), as [`Light::spectrum`]
-    /// says for each kind: the environment's radiance from `wi`, every other
-    /// light's one spectrum. A closure, not a `Cow`: returning a `Cow` of a
-    /// 36-bin spectrum from next-event estimation cost the Cornell box 4.5%
-    /// more instructions (callgrind), the other lights paying for the copy.
+    /// (from the shading point towards the light) from the light's point of
+    /// surface coordinates `uv`, as [`Light::spectrum`] says for each kind:
+    /// the environment's radiance from `wi`, a textured area light's texture
+    /// at `uv` (the `uv` its sample gave: [`Light::sample_li_uv`],
+    /// [`EmissionSample::uv`]), every other light's one spectrum. A closure,
+    /// not a `Cow`: returning a `Cow` of a 36-bin spectrum from next-event
+    /// estimation cost the Cornell box 4.5% more instructions (callgrind), the
+    /// other lights paying for the copy.
     #[inline(always)]
-    pub fn with_radiance<R>(&self, wi: Vec3, f: impl FnOnce(&Spectrum) -> R) -> R {
+    pub fn with_radiance<R>(&self, wi: Vec3, uv: Vec2, f: impl FnOnce(&Spectrum) -> R) -> R {
+        let mut slot = None;
+        let s = match self {
+            Light::Environment(l) => slot.insert(l.radiance(wi)),
+            _ => self.radiance_in(uv, &mut slot),
+        };
+        f(s)
+    }
+
+    /// The radiance of a light other than the environment from its point of
+    /// surface coordinates `uv`: a textured area light's texture there (built
+    /// in `slot`), any other light's one spectrum.
+    #[inline]
+    pub fn radiance_in<'a>(&'a self, uv: Vec2, slot: &'a mut Option<Spectrum>) -> &'a Spectrum {
+        match self.emission_texture() {
+            Some(t) => slot.insert(t.texture.eval(uv)),
+            None => self.spectrum(),
+        }
+    }
+
+    /// [`Light::with_radiance`] for a light without an emission texture
+    /// (cheaper: one branch, for the environment).
+    #[inline(always)]
+    pub fn with_radiance_at<R>(&self, wi: Vec3, f: impl FnOnce(&Spectrum) -> R) -> R {
         match self {
             Light::Environment(l) => f(&l.radiance(wi)),
             _ => f(self.spectrum()),
+        }
+    }
+
+    /// The texture of a textured area light's radiance.
+    #[inline]
+    pub fn emission_texture(&self) -> Option<&EmissionTexture> {
+        match self {
+            Light::Area(l) => l.texture.as_deref(),
+            Light::Sphere(l) => l.texture.as_deref(),
+            Light::Disk(l) => l.texture.as_deref(),
+            _ => None,
         }
     }
 
@@ -157,6 +219,18 @@ impl Light {
             Light::Distant(l) => l.sample_li(p),
             Light::Beam(l) => l.sample_li(p),
             Light::Environment(l) => l.sample_li(p, u),
+        }
+    }
+
+    /// [`Light::sample_li`], and the sampled point's surface coordinates on a
+    /// textured area light (else zero), for [`Light::with_radiance`].
+    #[inline(always)]
+    pub fn sample_li_uv(&self, p: Vec3, u: Vec2) -> Option<(LightSample, Vec2)> {
+        match self {
+            Light::Area(l) => l.sample_li_uv(p, u),
+            Light::Sphere(l) => l.sample_li(p, u).map(|s| (s, l.uv(s.point))),
+            Light::Disk(l) => l.sample_li(p, u).map(|s| (s, l.uv(s.point))),
+            _ => self.sample_li(p, u).map(|s| (s, Vec2::ZERO)),
         }
     }
 
@@ -243,16 +317,24 @@ impl Light {
         emission: &SpectrumDesc,
         two_sided: bool,
     ) -> Result<Light> {
-        let radiance = check.spectrum(&format!("{field}.emission"), emission)?;
-        let flat = |l: Option<AreaLight>| {
-            l.map(Light::Area).ok_or_else(|| check.err(format!("{field}.shape"), "an emitter needs a non-zero area"))
+        let emission_field = format!("{field}.emission");
+        let (radiance, texture) = match crate::texture::emission_from_desc(check, &emission_field, emission)? {
+            None => (check.spectrum(&emission_field, emission)?, None),
+            Some(texture) => {
+                let (mean, peak) = texture.mean_and_peak();
+                (peak, Some(Box::new(EmissionTexture { texture, mean })))
+            }
+        };
+        let flat = |l: Option<AreaLight>, mesh| {
+            l.map(|l| Light::Area(l.with_texture(texture.clone(), mesh)))
+                .ok_or_else(|| check.err(format!("{field}.shape"), "an emitter needs a non-zero area"))
         };
         Ok(match shape {
-            Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided }),
-            Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided }),
-            Shape::Quad(q) => flat(AreaLight::quad(q, radiance, two_sided))?,
-            Shape::Cuboid(c) => flat(AreaLight::cuboid(c, radiance, two_sided))?,
-            Shape::Mesh(m) => flat(AreaLight::mesh(m, radiance, two_sided))?,
+            Shape::Sphere(s) => Light::Sphere(SphereLight { sphere: *s, radiance, two_sided, texture }),
+            Shape::Disk(d) => Light::Disk(DiskLight { disk: *d, radiance, two_sided, texture }),
+            Shape::Quad(q) => flat(AreaLight::quad(q, radiance, two_sided), None)?,
+            Shape::Cuboid(c) => flat(AreaLight::cuboid(c, radiance, two_sided), None)?,
+            Shape::Mesh(m) => flat(AreaLight::mesh(m, radiance, two_sided), Some(m))?,
             Shape::Plane(_) | Shape::Bubble(_) => {
                 return Err(check.err(
                     format!("{field}.emission"),
@@ -294,6 +376,7 @@ pub(crate) mod tests {
             sphere: Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5),
             radiance: Spectrum::ONE,
             two_sided: false,
+            texture: None,
         });
         let p = Vec3::new(0.3, 0.0, 0.1);
         let shape = Sphere::new(Vec3::new(0.0, 2.0, 0.0), 0.5);
@@ -307,11 +390,92 @@ pub(crate) mod tests {
         }
     }
 
+    /// A textured emitter's sampled (u, v) is the (u, v) the shape gives the
+    /// same point when a ray hits it ([`Shape::uv`], what [`crate::scene::Scene::le`]
+    /// looks the texture up with), for next-event samples (`sample_li_uv`) and
+    /// emitted rays (`sample_le`), on every emitting shape: a quad, a cuboid's
+    /// six faces, a mesh with per-vertex uvs, a sphere, a disk. 300 samples each.
+    #[test]
+    fn textured_emitters_sample_the_uv_their_shape_gives_the_point() {
+        use crate::io::MeshData;
+        use crate::shape::{Cuboid, Mesh, Quad};
+        let texture = || {
+            let t = Texture::Checkerboard { even: Box::new(Spectrum::ONE), odd: Box::new(Spectrum::ZERO), scale: 2.0 };
+            Some(Box::new(EmissionTexture { texture: t, mean: Spectrum::splat(0.5) }))
+        };
+        let quad = Quad::new(Vec3::new(-0.5, 1.0, -0.3), Vec3::new(1.2, 0.1, 0.0), Vec3::new(0.0, 0.2, 0.9));
+        let cuboid = Cuboid::new(Vec3::new(-0.3, 0.8, -0.2), Vec3::new(0.4, 1.3, 0.5));
+        let positions = vec![
+            Vec3::new(-1.0, 1.0, -1.0),
+            Vec3::new(1.0, 1.2, -1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(-1.0, 0.9, 1.0),
+        ];
+        let uvs = Some(vec![[0.1, 0.2], [0.9, 0.3], [0.7, 0.95], [0.05, 0.8]]);
+        let data = MeshData { positions, triangles: vec![[0, 1, 2], [0, 2, 3]], normals: None, uvs };
+        let mesh =
+            Mesh::from_parts(data, &crate::geometry::Transform::default(), None, &crate::Error::Settings).unwrap();
+        let sphere = Sphere::new(Vec3::new(0.1, 1.5, 0.2), 0.4);
+        let disk =
+            Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::new(0.3, -1.0, 0.1).normalize(), radius: 0.6 };
+        let cases: Vec<(Light, Shape)> = vec![
+            (
+                Light::Area(AreaLight::quad(&quad, Spectrum::ONE, true).unwrap().with_texture(texture(), None)),
+                Shape::Quad(quad),
+            ),
+            (
+                Light::Area(AreaLight::cuboid(&cuboid, Spectrum::ONE, true).unwrap().with_texture(texture(), None)),
+                Shape::Cuboid(cuboid),
+            ),
+            (
+                Light::Area(AreaLight::mesh(&mesh, Spectrum::ONE, true).unwrap().with_texture(texture(), Some(&mesh))),
+                Shape::Mesh(Box::new(mesh.clone())),
+            ),
+            (
+                Light::Sphere(SphereLight { sphere, radiance: Spectrum::ONE, two_sided: true, texture: texture() }),
+                Shape::Sphere(sphere),
+            ),
+            (
+                Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: true, texture: texture() }),
+                Shape::Disk(disk),
+            ),
+        ];
+        let mut s = Sampler::new(11, 3, 1);
+        for (light, shape) in &cases {
+            let mut seen = 0;
+            for _ in 0..300 {
+                let p = Vec3::new(0.05, -0.5, 0.1);
+                if let Some((ls, uv)) = light.sample_li_uv(p, s.next_2d()) {
+                    let hit = shape.intersect(&Ray::new(p, ls.wi), f32::INFINITY).expect("the sample is on the shape");
+                    // A point behind the shape's own front (a cuboid's far faces) is not the hit.
+                    if (hit.p - ls.point).length() < 1e-4 {
+                        let want = shape.uv(&hit);
+                        assert!((uv - want).abs().max_element() < 2e-3, "{shape:?} sample_li: {uv} vs {want}");
+                        seen += 1;
+                    }
+                }
+                if let Some(e) = light.sample_le(s.next_2d(), s.next_2d()) {
+                    // A ray from just off the surface back at the point.
+                    let from = e.point + e.dir * 1e-2;
+                    let hit =
+                        shape.intersect(&Ray::new(from, -e.dir), f32::INFINITY).expect("the ray leaves the shape");
+                    // Near an edge, a grazing ray may meet the next face first.
+                    if (hit.p - e.point).length() < 1e-4 {
+                        let want = shape.uv(&hit);
+                        assert!((e.uv - want).abs().max_element() < 2e-3, "{shape:?} sample_le: {} vs {want}", e.uv);
+                        seen += 1;
+                    }
+                }
+            }
+            assert!(seen > 300, "{shape:?}: {seen} of 600 samples checked");
+        }
+    }
+
     /// The disk light's pdf integrates to 1 over the directions that see its front.
     #[test]
     fn disk_light_pdf_integrates_to_one() {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
-        let light = Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: false });
+        let light = Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: false, texture: None });
         let p = Vec3::new(0.5, 0.0, -0.2);
         let integral = pdf_integral(&light, |r| disk.intersect(r, f32::INFINITY), p, 2, 200_000);
         assert!((integral - 1.0).abs() < 0.04, "∫pdf = {integral}");
@@ -336,7 +500,7 @@ mod stability_tests {
     #[test]
     fn two_sided_sphere_pdf_by_area_from_inside_integrates_to_one() {
         let sphere = Sphere::new(Vec3::new(0.2, -0.1, 0.3), 1.5);
-        let light = Light::Sphere(SphereLight { sphere, radiance: Spectrum::ONE, two_sided: true });
+        let light = Light::Sphere(SphereLight { sphere, radiance: Spectrum::ONE, two_sided: true, texture: None });
         let p = Vec3::new(0.9, 0.4, -0.2);
         // From inside every direction hits the sphere.
         let integral = super::tests::pdf_integral(&light, |r| sphere.intersect(r, f32::INFINITY), p, 5, 200_000);
@@ -349,7 +513,7 @@ mod stability_tests {
             assert!((back - ls.pdf).abs() <= 1e-3 * ls.pdf, "{back} vs {}", ls.pdf);
         }
         // A one-sided sphere emits nothing inward: no sample, pdf 0.
-        let one = Light::Sphere(SphereLight { sphere, radiance: Spectrum::ONE, two_sided: false });
+        let one = Light::Sphere(SphereLight { sphere, radiance: Spectrum::ONE, two_sided: false, texture: None });
         assert!(one.sample_li(p, Vec2::splat(0.3)).is_none());
         assert_eq!(one.pdf_li(p, Vec3::X, p + Vec3::X, Vec3::ZERO), 0.0);
     }
@@ -359,7 +523,7 @@ mod stability_tests {
     #[test]
     fn two_sided_disk_pdf_integrates_to_one_from_both_sides() {
         let disk = Disk { center: Vec3::new(0.0, 1.0, 0.0), normal: Vec3::NEG_Y, radius: 0.4 };
-        let light = Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: true });
+        let light = Light::Disk(DiskLight { disk, radiance: Spectrum::ONE, two_sided: true, texture: None });
         for (seed, p) in [(3, Vec3::new(0.5, 0.0, -0.2)), (4, Vec3::new(-0.3, 1.6, 0.1))] {
             let integral = super::tests::pdf_integral(&light, |r| disk.intersect(r, f32::INFINITY), p, seed, 200_000);
             assert!((integral - 1.0).abs() < 0.04, "from {p}: ∫pdf = {integral}");
@@ -386,6 +550,7 @@ mod stability_tests {
                     sphere: Sphere::new(centre, r),
                     radiance: Spectrum::ONE,
                     two_sided: false,
+                    texture: None,
                 });
                 let p = Vec3::new(0.3, 0.2, -0.1);
                 let n = 4000;

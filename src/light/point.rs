@@ -63,6 +63,7 @@ impl PointLight {
             pdf_pos: 1.0,
             pdf_dir: 1.0 / (4.0 * PI),
             scale: 1.0,
+            uv: Vec2::ZERO,
         })
     }
 

@@ -13,11 +13,12 @@ use std::f32::consts::PI;
 
 use super::EmissionSample;
 use super::emit::{surface_pdf_dir, surface_ray};
-use super::{LightSample, sides};
+use super::{EmissionTexture, LightSample, mean_radiance, sides};
 use crate::color::Spectrum;
 use crate::geometry::Frame;
+use crate::geometry::Hit;
 use crate::sampler::warp::{cos_sin_2pi, uniform_sphere};
-use crate::shape::Sphere;
+use crate::shape::{Shape, Sphere};
 
 /// A spherical area light emitting `radiance` outward (and inward too when two-sided).
 #[derive(Clone, Debug)]
@@ -28,13 +29,16 @@ pub struct SphereLight {
     pub radiance: Spectrum,
     /// Emits from both sides.
     pub two_sided: bool,
+    /// The radiance over the surface's (u, v) when it varies (then
+    /// `radiance` is its per-bin peak).
+    pub texture: Option<Box<EmissionTexture>>,
 }
 
 impl SphereLight {
     /// Total power up to the spectrum's shape: `π A` times the mean radiance per side.
     pub fn power(&self) -> f32 {
         let r = self.sphere.radius;
-        sides(self.two_sided) * PI * 4.0 * PI * r * r * self.radiance.average()
+        sides(self.two_sided) * PI * 4.0 * PI * r * r * mean_radiance(&self.radiance, &self.texture)
     }
 
     /// Samples a direction from `p` towards the sphere.
@@ -142,7 +146,16 @@ impl SphereLight {
         let n = uniform_sphere(u_pos);
         let point = self.sphere.center + n * self.sphere.radius;
         let area = 4.0 * PI * self.sphere.radius * self.sphere.radius;
-        surface_ray(point, n, area, self.two_sided, u_dir)
+        surface_ray(point, n, self.uv(point), area, self.two_sided, u_dir)
+    }
+
+    /// The (u, v) of `point` on the sphere when the light has a texture (else zero).
+    #[inline]
+    pub(super) fn uv(&self, point: Vec3) -> Vec2 {
+        match self.texture {
+            Some(_) => Shape::Sphere(self.sphere).uv(&Hit::flat(0.0, point, Vec3::ZERO)),
+            None => Vec2::ZERO,
+        }
     }
 
     /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].

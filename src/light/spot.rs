@@ -102,6 +102,7 @@ impl SpotLight {
             pdf_pos: 1.0,
             pdf_dir: 1.0 / (2.0 * PI * one_minus_cos),
             scale,
+            uv: Vec2::ZERO,
         })
     }
 

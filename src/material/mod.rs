@@ -6,10 +6,11 @@
 //! `from_desc` here (checks every field, looks up named metals and glasses,
 //! builds spectra and indices) → [`Bxdf`] (stored once per named material in
 //! [`crate::scene::Scene::materials`]; objects refer to it by index), and,
-//! where the reflectance is a texture (`Image`, `Checkerboard`: Lambertian,
-//! OrenNayar, Mirror and Plastic), the [`Texture`] beside it, which
-//! [`crate::scene::Scene::bsdf_in`] evaluates at each hit
-//! ([`Bxdf::with_reflectance`]).
+//! where the reflectance (Lambertian, OrenNayar, Mirror and Plastic), the
+//! roughness (Conductor, Dielectric, Plastic) or a thin film's thickness is
+//! a texture (`Image`, `Checkerboard`), the [`MaterialTextures`] beside it,
+//! which [`crate::scene::Scene::bsdf_in`] applies at each hit
+//! ([`Bxdf::with_reflectance`], [`Bxdf::set_roughness`], [`Bxdf::set_thickness_nm`]).
 //!
 //! Errors name the scene file and the field path
 //! (`materials."gold".roughness`) and what was expected.
@@ -20,13 +21,13 @@ use crate::bxdf::{
 use crate::color::{self, N_BINS};
 use crate::error::Result;
 use crate::scene::check::Check;
-use crate::scene::desc::{CoatingDesc, IorDesc, MaterialDesc, SpectrumDesc};
-use crate::texture::{self, Texture};
+use crate::scene::desc::{CoatingDesc, IorDesc, MaterialDesc, ScalarDesc, SpectrumDesc};
+use crate::texture::{self, MaterialTextures};
 
 /// The [`Bxdf`] of a material description at `field` (`materials."name"`), and
-/// its reflectance texture if it has one.
-pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<(Bxdf, Option<Texture>)> {
-    let texture = match d {
+/// its textures if it has any.
+pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<(Bxdf, Option<MaterialTextures>)> {
+    let reflectance = match d {
         MaterialDesc::Lambertian { reflectance }
         | MaterialDesc::OrenNayar { reflectance, .. }
         | MaterialDesc::Mirror { reflectance }
@@ -35,13 +36,40 @@ pub(crate) fn from_desc(check: &Check, field: &str, d: &MaterialDesc) -> Result<
         }
         _ => None,
     };
-    // A textured material's lobe is built with a stand-in reflectance (grey ½),
-    // replaced at every hit.
+    let roughness = match d {
+        MaterialDesc::Dielectric { roughness: ScalarDesc::Texture(t), .. }
+        | MaterialDesc::Conductor { roughness: ScalarDesc::Texture(t), .. }
+        | MaterialDesc::Plastic { roughness: ScalarDesc::Texture(t), .. } => {
+            Some(texture::scalar_from_desc(check, &format!("{field}.roughness"), t, (0.0, 1.0), "a GGX alpha")?)
+        }
+        _ => None,
+    };
+    let (film_field, thickness) = match d {
+        MaterialDesc::Dielectric { coating: Some(CoatingDesc::ThinFilm { thickness_nm, .. }), .. }
+        | MaterialDesc::Conductor { coating: Some(CoatingDesc::ThinFilm { thickness_nm, .. }), .. } => {
+            (format!("{field}.coating.thickness_nm"), thickness_nm)
+        }
+        MaterialDesc::ThinSheet { thickness_nm, .. } => (format!("{field}.thickness_nm"), thickness_nm),
+        _ => (String::new(), &ScalarDesc::Value(0.0)),
+    };
+    let thickness_nm = match thickness {
+        ScalarDesc::Texture(t) => {
+            Some(texture::scalar_from_desc(check, &film_field, t, (0.0, MAX_THICKNESS_NM), "a thickness in nm")?)
+        }
+        ScalarDesc::Value(_) => None,
+    };
+    // A textured material's lobe is built with a stand-in reflectance (grey
+    // ½), roughness (α ½: rough, as every value of the texture is) and
+    // thickness, each replaced at every hit.
     const STAND_IN: &SpectrumDesc = &SpectrumDesc::Constant(0.5);
-    let textured = texture.is_some();
+    let textured = reflectance.is_some();
     let bxdf = bxdf_of(check, field, d, |r| if textured { STAND_IN } else { r })?;
-    Ok((bxdf, texture))
+    let textures = MaterialTextures { reflectance, roughness, thickness_nm };
+    Ok((bxdf, (!textures.is_empty()).then_some(textures)))
 }
+
+/// The largest thin-film thickness, in nm.
+const MAX_THICKNESS_NM: f32 = 1e7;
 
 /// The [`Bxdf`] of a material description, its reflectance description passed through `reflectance`.
 fn bxdf_of<'a>(
@@ -72,13 +100,13 @@ fn bxdf_of<'a>(
             let mut d = Dielectric::new(check.ior(&format!("{field}.ior"), ior)?).with_roughness(ggx_alpha(
                 check,
                 &format!("{field}.roughness"),
-                *roughness,
+                roughness,
             )?);
             if let Some(a) = absorption {
                 d = d.with_absorption(check.spectrum(&format!("{field}.absorption"), a)?);
             }
             if let Some(CoatingDesc::ThinFilm { thickness_nm, ior }) = coating {
-                d = d.with_coating(thin_film(check, &format!("{field}.coating"), *thickness_nm, ior)?);
+                d = d.with_coating(thin_film(check, &format!("{field}.coating"), thickness_nm, ior)?);
             }
             Bxdf::Dielectric(d)
         }
@@ -105,10 +133,10 @@ fn bxdf_of<'a>(
             let coating = match coating {
                 None => None,
                 Some(CoatingDesc::ThinFilm { thickness_nm, ior }) => {
-                    Some(thin_film(check, &format!("{field}.coating"), *thickness_nm, ior)?)
+                    Some(thin_film(check, &format!("{field}.coating"), thickness_nm, ior)?)
                 }
             };
-            let alpha = ggx_alpha(check, &format!("{field}.roughness"), *roughness)?;
+            let alpha = ggx_alpha(check, &format!("{field}.roughness"), roughness)?;
             Bxdf::Conductor(Conductor { eta, k, alpha, coating })
         }
         MaterialDesc::Plastic { reflectance: r, ior, roughness } => {
@@ -125,20 +153,25 @@ fn bxdf_of<'a>(
             Bxdf::Plastic(Plastic::new(
                 check.reflectance(&format!("{field}.reflectance"), reflectance(r))?,
                 &ior,
-                ggx_alpha(check, &format!("{field}.roughness"), *roughness)?,
+                ggx_alpha(check, &format!("{field}.roughness"), roughness)?,
             ))
         }
         MaterialDesc::ThinSheet { thickness_nm, ior } => {
-            Bxdf::ThinSheet(ThinSheet { film: thin_film(check, field, *thickness_nm, ior)? })
+            Bxdf::ThinSheet(ThinSheet { film: thin_film(check, field, thickness_nm, ior)? })
         }
         MaterialDesc::Black => Bxdf::Black,
         MaterialDesc::Interface => Bxdf::Interface,
     })
 }
 
-/// A thin film: a thickness in [0, 1e7] nm and an index of at least 1.
-fn thin_film(check: &Check, field: &str, thickness_nm: f32, ior: &IorDesc) -> Result<ThinFilm> {
-    if !(thickness_nm.is_finite() && (0.0..=1e7).contains(&thickness_nm)) {
+/// A thin film: a thickness in [0, 1e7] nm (a texture's stand-in: 0, its
+/// values are checked with the texture) and an index of at least 1.
+fn thin_film(check: &Check, field: &str, thickness_nm: &ScalarDesc, ior: &IorDesc) -> Result<ThinFilm> {
+    let thickness_nm = match thickness_nm {
+        ScalarDesc::Value(v) => *v,
+        ScalarDesc::Texture(_) => 0.0,
+    };
+    if !(thickness_nm.is_finite() && (0.0..=MAX_THICKNESS_NM).contains(&thickness_nm)) {
         return Err(check.err(
             format!("{field}.thickness_nm"),
             format!("expected a thickness in nm in [0, 1e7], found {thickness_nm}"),
@@ -148,8 +181,13 @@ fn thin_film(check: &Check, field: &str, thickness_nm: f32, ior: &IorDesc) -> Re
     Ok(ThinFilm::new(thickness_nm, &ior))
 }
 
-/// A GGX α: a number in [0, 1] (0 is smooth).
-fn ggx_alpha(check: &Check, field: &str, alpha: f32) -> Result<f32> {
+/// A GGX α: a number in [0, 1] (0 is smooth); a texture's stand-in ½ (its
+/// values are checked with the texture).
+fn ggx_alpha(check: &Check, field: &str, alpha: &ScalarDesc) -> Result<f32> {
+    let alpha = match alpha {
+        ScalarDesc::Value(v) => *v,
+        ScalarDesc::Texture(_) => 0.5,
+    };
     if alpha.is_finite() && (0.0..=1.0).contains(&alpha) {
         Ok(alpha)
     } else {

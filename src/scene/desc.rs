@@ -169,7 +169,7 @@ pub enum SpectrumDesc {
     /// (components in [0, 1]) its colour under D65; as an emission the colour times D65, so the
     /// emitter seen directly renders `(r, g, b)`: `Rgb(0.8, 0.2, 0.1)`.
     Rgb(f32, f32, f32),
-    /// An image texture (a material's reflectance only; see `crate::texture`):
+    /// An image texture (a material's reflectance or an object's emission; see `crate::texture`):
     /// `Image(path: "wood.png", uv_scale: (2, 2), uv_offset: (0, 0), wrap: Repeat, scale: 1)`.
     Image {
         /// A PNG (sRGB) or EXR (linear) file, relative to the scene file.
@@ -183,11 +183,11 @@ pub enum SpectrumDesc {
         /// Outside [0, 1]: `Repeat` (default) or `Clamp`.
         #[serde(default)]
         wrap: Wrap,
-        /// A factor on every texel (default 1); the product is clamped to [0, 1].
+        /// A factor on every texel (default 1); for a reflectance the product is clamped to [0, 1].
         #[serde(default = "one")]
         scale: f32,
     },
-    /// A checkerboard over (u, v) (a material's reflectance only):
+    /// A checkerboard over (u, v) (a material's reflectance or an object's emission):
     /// `Checkerboard(even: Constant(0.8), odd: Rgb(0.1, 0.1, 0.3), scale: 8)`.
     Checkerboard {
         /// The squares where `⌊N u⌋ + ⌊N v⌋` is even.
@@ -266,9 +266,9 @@ pub enum MaterialDesc {
     Dielectric {
         /// Index of refraction of the inside.
         ior: IorDesc,
-        /// GGX α in [0, 1] (default 0: smooth).
+        /// GGX α in [0, 1] (default 0: smooth), or a texture of α.
         #[serde(default)]
-        roughness: f32,
+        roughness: ScalarDesc,
         /// Absorption coefficient inside, per scene unit (default: clear).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         absorption: Option<SpectrumDesc>,
@@ -289,9 +289,9 @@ pub enum MaterialDesc {
         /// The extinction coefficient (imaginary part), per wavelength.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         k: Option<SpectrumDesc>,
-        /// GGX α in [0, 1] (default 0: smooth).
+        /// GGX α in [0, 1] (default 0: smooth), or a texture of α.
         #[serde(default)]
-        roughness: f32,
+        roughness: ScalarDesc,
         /// A thin film on the metal: `coating: ThinFilm(thickness_nm: 300, ior: Constant(1.45))`.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         coating: Option<CoatingDesc>,
@@ -303,22 +303,108 @@ pub enum MaterialDesc {
         reflectance: SpectrumDesc,
         /// The coat's index of refraction.
         ior: IorDesc,
-        /// GGX α of the coat in [0, 1] (default 0: smooth).
+        /// GGX α of the coat in [0, 1] (default 0: smooth), or a texture of α.
         #[serde(default)]
-        roughness: f32,
+        roughness: ScalarDesc,
     },
     /// An index-matched boundary (`Interface`): light passes straight through; it
     /// bounds the volume its object's `interior:` medium fills.
     Interface,
     /// A free-standing thin film (soap film): `ThinSheet(thickness_nm: 400, ior: Constant(1.33))`.
     ThinSheet {
-        /// Thickness in nm.
-        thickness_nm: f32,
+        /// Thickness in nm, or a texture of thicknesses.
+        thickness_nm: ScalarDesc,
         /// The film's index of refraction.
         ior: IorDesc,
     },
     /// Absorbs everything.
     Black,
+}
+
+/// A scalar material parameter (`roughness`, `thickness_nm`): a number, as
+/// always (`roughness: 0.2`), or a texture of numbers over the surface's
+/// (u, v) (`roughness: Image(path: "rough.png", scale: 0.5)`,
+/// `roughness: Checkerboard(even: 0.1, odd: 0.4, scale: 8)`; see
+/// `crate::texture::ScalarTexture`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum ScalarDesc {
+    /// The same value everywhere.
+    Value(f32),
+    /// A texture of values.
+    Texture(ScalarTextureDesc),
+}
+
+impl Default for ScalarDesc {
+    fn default() -> Self {
+        ScalarDesc::Value(0.0)
+    }
+}
+
+impl From<f32> for ScalarDesc {
+    fn from(v: f32) -> Self {
+        ScalarDesc::Value(v)
+    }
+}
+
+/// What [`ScalarDesc`] accepts, for its error message.
+const SCALAR_EXPECTED: &str = "expected a number (`roughness: 0.2`), \
+    `Image(path: \"...\", uv_scale: (1, 1), uv_offset: (0, 0), wrap: Repeat, scale: 1)` \
+    or `Checkerboard(even: 0.1, odd: 0.4, scale: 8)` (numbers, not spectra)";
+
+impl<'de> Deserialize<'de> for ScalarDesc {
+    /// A number or a texture (serde's untagged choice, which RON supports);
+    /// anything else is one error listing the three forms at the value's
+    /// position (the untagged choice alone says only "did not match any variant").
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Value(f32),
+            Texture(ScalarTextureDesc),
+        }
+        match Raw::deserialize(d) {
+            Ok(Raw::Value(v)) => Ok(ScalarDesc::Value(v)),
+            Ok(Raw::Texture(t)) => Ok(ScalarDesc::Texture(t)),
+            Err(_) => Err(serde::de::Error::custom(SCALAR_EXPECTED)),
+        }
+    }
+}
+
+/// A texture of numbers (a [`ScalarDesc`] that varies).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub enum ScalarTextureDesc {
+    /// An image's luminance (`0.2126 R + 0.7152 G + 0.0722 B` of its linear
+    /// sRGB, the grey itself where R = G = B) times `scale`, looked up as a
+    /// reflectance image is:
+    /// `Image(path: "rough.png", uv_scale: (1, 1), uv_offset: (0, 0), wrap: Repeat, scale: 0.5)`.
+    Image {
+        /// A PNG (sRGB) or EXR (linear) file, relative to the scene file.
+        path: String,
+        /// Multiplies (u, v) before the lookup (default `(1, 1)`).
+        #[serde(default = "ones2")]
+        uv_scale: [f32; 2],
+        /// Added to (u, v) after `uv_scale` (default `(0, 0)`).
+        #[serde(default)]
+        uv_offset: [f32; 2],
+        /// Outside [0, 1]: `Repeat` (default) or `Clamp`.
+        #[serde(default)]
+        wrap: Wrap,
+        /// A factor on every texel's luminance (default 1).
+        #[serde(default = "one")]
+        scale: f32,
+    },
+    /// Two numbers in a checkerboard over (u, v):
+    /// `Checkerboard(even: 0.1, odd: 0.4, scale: 8)`.
+    Checkerboard {
+        /// The value on the squares where `⌊N u⌋ + ⌊N v⌋` is even.
+        even: f32,
+        /// The value on the other squares.
+        odd: f32,
+        /// `N`, squares per unit of u and of v.
+        scale: f32,
+    },
 }
 
 /// A coating on a surface.
@@ -327,8 +413,8 @@ pub enum MaterialDesc {
 pub enum CoatingDesc {
     /// A thin film of `thickness_nm` and index `ior` (interference per wavelength).
     ThinFilm {
-        /// Thickness in nm.
-        thickness_nm: f32,
+        /// Thickness in nm, or a texture of thicknesses.
+        thickness_nm: ScalarDesc,
         /// The film's index of refraction.
         ior: IorDesc,
     },
@@ -437,7 +523,8 @@ pub struct ObjectDesc {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// Emitted radiance, making the object an area light (spheres, disks,
-    /// quads, cuboids and meshes).
+    /// quads, cuboids and meshes); a spectrum, or a texture (`Image`,
+    /// `Checkerboard`) over the surface's (u, v).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emission: Option<SpectrumDesc>,
     /// Whether the emission leaves both sides of the surface (default false:

@@ -27,7 +27,7 @@ use crate::medium::{Medium, VOLUME_STACK_DEPTH, Volume, VolumeStack};
 use crate::settings::Settings;
 use crate::shape::Shape;
 use crate::shape::{Batch, Bvh};
-use crate::texture::Texture;
+use crate::texture::MaterialTextures;
 
 /// Below this many bounded objects the scene tests them one by one instead of
 /// building a BVH over them. Measured with callgrind (instructions for a 32x32,
@@ -77,7 +77,7 @@ pub struct Scene {
     pub materials: Vec<Bxdf>,
     /// Each material's reflectance texture, if it has one (index for index
     /// with `materials`; empty when no material has one).
-    textures: Vec<Option<Texture>>,
+    textures: Vec<Option<MaterialTextures>>,
     /// Lights (area lights refer back to their object).
     pub lights: Vec<Light>,
     /// Probability of choosing each light for next-event estimation (∝ power).
@@ -114,6 +114,9 @@ pub struct Scene {
     /// Whether any object's material is dispersive (computed once: the
     /// `spectral` integrator asks for every camera sample).
     dispersive: bool,
+    /// Some area light's emission is a texture: only then do light samples
+    /// and emitter hits look for one ([`Scene::le`], [`Scene::sample_li`]).
+    emission_textures: bool,
     /// The identity of the scene file and every file it reads (for
     /// checkpoints: resume and merge refuse other inputs).
     pub content_hash: u64,
@@ -134,7 +137,7 @@ impl Scene {
     pub fn new(
         objects: Vec<Object>,
         materials: Vec<Bxdf>,
-        textures: Vec<Option<Texture>>,
+        textures: Vec<Option<MaterialTextures>>,
         mut lights: Vec<Light>,
         camera: Camera,
         settings: Settings,
@@ -205,6 +208,7 @@ impl Scene {
             })
             .collect();
         let dispersive = objects.iter().any(|o| materials.get(o.material as usize).is_some_and(Bxdf::is_dispersive));
+        let emission_textures = lights.iter().any(|l| l.emission_texture().is_some());
         let environment = lights.iter().position(Light::is_infinite).map(|i| i as u32);
         let textures = if textures.iter().any(Option::is_some) { textures } else { Vec::new() };
         Scene {
@@ -212,6 +216,7 @@ impl Scene {
             environment,
             radius,
             dispersive,
+            emission_textures,
             objects,
             materials,
             lights,

@@ -108,7 +108,8 @@ impl Check<'_> {
             SpectrumDesc::Image { .. } | SpectrumDesc::Checkerboard { .. } => {
                 return Err(self.err(
                     field,
-                    "a texture (Image, Checkerboard) can stand only for a material's reflectance; expected a spectrum",
+                    "a texture (Image, Checkerboard) can stand only for a material's reflectance or an object's emission \
+                     (not inside another texture); expected a spectrum",
                 ));
             }
             SpectrumDesc::Rayleigh(s) => {

@@ -154,9 +154,11 @@ impl Bdpt {
                 }
                 let c = if pt.collapsed {
                     let one = wl.single();
-                    Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(light.spectrum())[0] * le)
+                    scene.with_radiance(index, dir, pt.uv, |s| {
+                        Contrib::Single(pt.beta[one.slot] * one.lambdas.sample(s)[0] * le)
+                    })
                 } else {
-                    Contrib::Full(pt.beta * *light.spectrum() * le)
+                    scene.with_radiance(index, dir, pt.uv, |s| Contrib::Full(pt.beta * *s * le))
                 };
                 let (pdf_pos, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
                 let pt_rev = scene.light_pmf(index) * pdf_pos;
@@ -174,7 +176,8 @@ impl Bdpt {
                 if !connectible(scene, pt) {
                     return NONE;
                 }
-                let Some(LightChoice { light: index, pmf, sample: ls }) = scene.sample_li(pt.p(), u_light, u) else {
+                let Some(LightChoice { light: index, pmf, sample: ls, uv }) = scene.sample_li(pt.p(), u_light, u)
+                else {
                     return NONE;
                 };
                 let light = scene.light(index);
@@ -190,11 +193,11 @@ impl Bdpt {
                 let c = if pt.collapsed || is_dispersive(scene, pt) {
                     let one = wl.single();
                     let f = sc.eval(pt.sh.wo, wi, &one.lambdas)[0];
-                    let le = light.with_radiance(ls.wi, |s| one.lambdas.sample(s)[0]);
+                    let le = scene.with_radiance(index, ls.wi, uv, |s| one.lambdas.sample(s)[0]);
                     Contrib::Single(wl.at(&pt.beta, pt.collapsed) * f * le * k)
                 } else {
                     let f = sc.eval(pt.sh.wo, wi, &Lambdas::full());
-                    light.with_radiance(ls.wi, |s| Contrib::Full(pt.beta * f * *s * k))
+                    scene.with_radiance(index, ls.wi, uv, |s| Contrib::Full(pt.beta * f * *s * k))
                 };
                 if is_black(&c) {
                     return NONE;
@@ -286,9 +289,9 @@ impl Bdpt {
         let dir = (pt.p() - ptm.p()).normalize();
         let c = if pt.collapsed {
             let one = wl.single();
-            Contrib::Single(pt.beta[one.slot] * light.with_radiance(dir, |s| one.lambdas.sample(s)[0]))
+            Contrib::Single(pt.beta[one.slot] * light.with_radiance_at(dir, |s| one.lambdas.sample(s)[0]))
         } else {
-            Contrib::Full(light.with_radiance(dir, |s| pt.beta * *s))
+            Contrib::Full(light.with_radiance_at(dir, |s| pt.beta * *s))
         };
         if t == 2 {
             return c;

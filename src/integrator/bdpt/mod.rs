@@ -287,7 +287,7 @@ impl Bdpt {
             return;
         }
         let infinite = light.is_infinite();
-        let beta0 = light.with_radiance(-e.dir, |s| *s / pdf_origin);
+        let beta0 = scene.with_radiance(index as u32, -e.dir, e.uv, |s| *s / pdf_origin);
         // The environment's first vertex is a direction: its density is the
         // direction's (per solid angle), as a camera subpath escaping along it sees it.
         let pdf_y0 = if infinite { pmf * e.pdf_dir } else { pdf_origin };

@@ -64,8 +64,7 @@ impl Walk {
                 break;
             };
             let hit = si.hit;
-            let textured = scene.texture(si.object).is_some();
-            let uv = if textured { scene.uv(&si) } else { glam::Vec2::ZERO };
+            let uv = if scene.needs_uv(si.object) { scene.uv(&si) } else { glam::Vec2::ZERO };
             let mut slot = None;
             let bxdf = scene.bsdf_uv(si.object, uv, &mut slot);
             // The medium the segment ran in: Beer-Lambert where it only absorbs;

@@ -61,7 +61,13 @@ impl Parser<'_> {
             self.param(ps, &n("eta"));
             self.param(ps, &n("k"));
             if METALS.contains(&m.as_str()) {
-                return Ok(MaterialDesc::Conductor { metal: Some(m), eta: None, k: None, roughness, coating: None });
+                return Ok(MaterialDesc::Conductor {
+                    metal: Some(m),
+                    eta: None,
+                    k: None,
+                    roughness: roughness.into(),
+                    coating: None,
+                });
             }
             self.warn(
                 at,
@@ -71,7 +77,7 @@ impl Parser<'_> {
                 metal: Some("Al".into()),
                 eta: None,
                 k: None,
-                roughness,
+                roughness: roughness.into(),
                 coating: None,
             });
         }
@@ -83,13 +89,19 @@ impl Parser<'_> {
                 metal: Some("Cu".into()),
                 eta: None,
                 k: None,
-                roughness,
+                roughness: roughness.into(),
                 coating: None,
             });
         }
         let eta = self.spectrum(ps, &n("eta"), Role::Unbounded)?.map(|s| s.0).unwrap_or(SpectrumDesc::Constant(1.0));
         let k = self.spectrum(ps, &n("k"), Role::Unbounded)?.map(|s| s.0).unwrap_or(SpectrumDesc::Constant(0.0));
-        Ok(MaterialDesc::Conductor { metal: None, eta: Some(eta), k: Some(k), roughness, coating: None })
+        Ok(MaterialDesc::Conductor {
+            metal: None,
+            eta: Some(eta),
+            k: Some(k),
+            roughness: roughness.into(),
+            coating: None,
+        })
     }
 
     /// `Material` or `MakeNamedMaterial` (then `name` is given).
@@ -109,7 +121,7 @@ impl Parser<'_> {
                 for p in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
                     self.param(ps, p);
                 }
-                MaterialDesc::Plastic { reflectance, ior, roughness }
+                MaterialDesc::Plastic { reflectance, ior, roughness: roughness.into() }
             }
             "conductor" => self.conductor(ps, "", at)?,
             "coatedconductor" => {
@@ -135,7 +147,7 @@ impl Parser<'_> {
                 }
                 let ior = self.ior(ps, "eta")?;
                 let roughness = self.roughness(ps, "", at)?;
-                MaterialDesc::Dielectric { ior, roughness, absorption: None, coating: None }
+                MaterialDesc::Dielectric { ior, roughness: roughness.into(), absorption: None, coating: None }
             }
             "diffusetransmission" => {
                 self.warn(
