@@ -108,7 +108,13 @@ impl Sensor {
         if arg.as_os_str() == CIE1931 {
             return Ok(Sensor::cie1931().clone());
         }
-        let bytes = crate::io::read_input(arg)?;
+        let bytes = crate::io::read_input(arg).map_err(|e| match e {
+            Error::Io { source, .. } => Error::Settings(format!(
+                "--sensor {}: {source}; expected `cie1931` or a CSV of `wavelength_nm,r,g,b` rows",
+                crate::error::show_path(arg)
+            )),
+            e => Error::Settings(format!("--sensor: {e}")),
+        })?;
         let text = String::from_utf8(bytes).map_err(|e| Error::Scene {
             path: arg.to_path_buf(),
             position: None,
