@@ -408,8 +408,12 @@ fn readme_is_short_and_shows_the_two_commands() {
     let lines = readme.lines().count();
     assert!(lines <= 300, "README.md has {lines} lines; at most 300");
     let two = "```sh\ncargo run --release -- render scenes/cornell.ron -o cornell.png   # render the thesis's Cornell box\n\
-               cargo test --locked                                               # the test suite (what CI runs)\n```";
+               cargo test --release --locked                                     # the test suite (what CI runs)\n```";
     assert!(readme.contains(two), "README.md lost its two-commands block:\n{two}");
+    // CI runs the README's test command as written (and the test profile's after it).
+    let ci = read(&root().join(".ci/run"));
+    let runs: Vec<&str> = ci.lines().filter(|l| l.starts_with("cargo test")).collect();
+    assert_eq!(runs, ["cargo test --release --locked", "cargo test --locked"], ".ci/run's test commands");
     // The README's one scene example (loaded by tests/scenes.rs) is scene-format.md's first.
     let readme_ron = ron_blocks(&readme);
     let page_ron = ron_blocks(&read(&scene_format_path()));
