@@ -31,6 +31,8 @@ pub(crate) struct Imported {
     pub(crate) warnings: Vec<String>,
     /// Per object: the PLY file its triangles came from, if any.
     pub(crate) mesh_files: Vec<Option<String>>,
+    /// Per group member: the PLY file its triangles came from, if any.
+    pub(crate) group_files: Vec<Vec<Option<String>>>,
     /// Where the description's objects and environment come from (see [`locate`]).
     pub(crate) places: Places,
 }
@@ -116,11 +118,13 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
             materials: NamedMap(b.materials),
             media: NamedMap(b.media),
             objects: b.objects,
+            groups: NamedMap(b.groups),
             lights: b.lights,
             environment: b.environment,
         },
         warnings,
         mesh_files: b.mesh_files,
+        group_files: b.group_files,
         places,
     })
 }
