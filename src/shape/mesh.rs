@@ -3,7 +3,7 @@
 //! mesh's own [`WideBvh`], which also stores the triangles (four to a block, in leaf
 //! order); `Hit::prim` is a triangle's index in that order (its slot).
 
-use super::Placement;
+use super::{Placement, Then};
 use crate::io::{fnv1a, parse_mesh, read_input};
 use crate::scene::check::Check;
 use crate::scene::desc::{ScaleDesc, V3};
@@ -22,17 +22,6 @@ use crate::io::{MeshData, read_mesh_file};
 pub(crate) struct MeshAhead {
     path: PathBuf,
     read: Result<(u64, Result<Mesh>)>,
-}
-
-/// How an object places a mesh after the mesh's own transform: its `transform:` as
-/// scale, rotation and translation, or a general affine `matrix:` (a linear part and
-/// a translation; checked finite and non-singular by the loader).
-#[derive(Clone, Copy, Debug)]
-pub(crate) enum Then {
-    /// Scale, rotate, translate.
-    Srt(Transform),
-    /// `x -> m x + t`.
-    Affine(Mat3, Vec3),
 }
 
 /// A triangle mesh with optional per-vertex normals and its own BVH.

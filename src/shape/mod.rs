@@ -33,7 +33,7 @@ pub use cuboid::Cuboid;
 pub use disk::Disk;
 pub use instance::{MAX_CANCELLATION, MeshInstance};
 pub use mesh::Mesh;
-pub(crate) use mesh::{MeshAhead, Then};
+pub(crate) use mesh::MeshAhead;
 pub use plane::Plane;
 pub use quad::Quad;
 pub use sphere::Sphere;
@@ -110,6 +110,17 @@ impl Shape {
             Shape::Instance(s) => Some(s.bounds()),
         }
     }
+}
+
+/// How an object places a mesh after the mesh's own transform: its `transform:` as
+/// scale, rotation and translation, or a general affine `matrix:` (a linear part and
+/// a translation; checked finite and non-singular by the loader).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Then {
+    /// Scale, rotate, translate.
+    Srt(Transform),
+    /// `x -> m x + t`.
+    Affine(glam::Mat3, Vec3),
 }
 
 /// An object's `transform:` ([`crate::scene::desc::TransformDesc`]), checked, with its
