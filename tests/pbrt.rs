@@ -530,6 +530,16 @@ element face 4\nproperty list uchar int vertex_indices\nend_header\n\
     );
     assert!(d.join("out-group-0-mesh-1.ply").exists());
     assert_same_films(&a, &film_of(&load_scene(&ron, &small()).unwrap()));
+    // A group member's error is at its `Shape` directive, the field kept in the message.
+    let flat = write(
+        &d,
+        "flat.pbrt",
+        &format!(
+            "{HEAD}ObjectBegin \"t\"\n  Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 2 0 0] \"integer indices\" [0 1 2]\nObjectEnd\nObjectInstance \"t\"\n"
+        ),
+    );
+    let e = load_scene(&flat, &small()).err().map(|e| e.to_string()).expect("an error");
+    assert!(e.contains("flat.pbrt:7:9:") && e.contains("groups.\"t\"[0]") && e.contains("no valid triangles"), "{e}");
 }
 
 // ---------------------------------------------------------------------------

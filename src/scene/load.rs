@@ -188,7 +188,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     // thread pool; the loop below takes them in object order, so the scene,
     // its identity and the first error are those of loading one by one. A mesh
     // whose transform is invalid is left to the loop, which reports it.
-    let jobs: Vec<(usize, PathBuf, Transform, Option<Then>)> = desc
+    let jobs: Vec<MeshJob<usize>> = desc
         .objects
         .iter()
         .enumerate()
@@ -402,14 +402,38 @@ fn placement(ctx: &Check<'_>, field: &str, t: &TransformDesc) -> Result<Placemen
     Ok(Placement { t: Transform::default(), matrix: Some((m, col(3))), field: tf })
 }
 
+/// A mesh file to read ahead: its key, path, own transform and its object's placement.
+type MeshJob<K> = (K, PathBuf, Transform, Option<Then>);
+
 /// A group's members, built once in group space: the shared mesh, material and priority.
 type Group = Vec<(std::sync::Arc<Mesh>, u32, u32)>;
 
 /// The scene's `groups:`, each member checked (a mesh with a material; no emission,
 /// `interior` or `exterior`) and built once.
 fn groups(ctx: &Check<'_>, desc: &SceneDesc, materials: &BTreeMap<&str, u32>) -> Result<BTreeMap<String, Group>> {
+    // The groups' mesh files are read and built at once on the thread pool, as the
+    // objects' are (see `build`); the loop takes them in order.
+    let jobs: Vec<MeshJob<(usize, usize)>> = desc
+        .groups
+        .0
+        .iter()
+        .enumerate()
+        .flat_map(|(g, (name, members))| members.iter().enumerate().map(move |(j, o)| (g, name, j, o)))
+        .filter_map(|(g, name, j, o)| {
+            let ShapeDesc::Mesh { path, scale, rotate_deg, translate } = &o.shape else { return None };
+            let field = format!("groups.\"{name}\"[{j}]");
+            let own = ctx.transform(&format!("{field}.shape"), scale, rotate_deg, translate).ok()?;
+            let then = match &o.transform {
+                None => None,
+                Some(t) => Some(placement(ctx, &field, t).ok()?.then()),
+            };
+            Some(((g, j), ctx.dir.join(path), own, then))
+        })
+        .collect();
+    let mut ahead: BTreeMap<(usize, usize), MeshAhead> =
+        jobs.into_par_iter().map(|(k, path, own, then)| (k, Mesh::read_ahead(path, &own, then.as_ref()))).collect();
     let mut out = BTreeMap::new();
-    for (name, members) in &desc.groups.0 {
+    for (g, (name, members)) in desc.groups.0.iter().enumerate() {
         let gf = format!("groups.\"{name}\"");
         if members.is_empty() {
             return Err(ctx.err(&gf, "an empty group: expected at least one object"));
@@ -433,24 +457,29 @@ fn groups(ctx: &Check<'_>, desc: &SceneDesc, materials: &BTreeMap<&str, u32>) ->
                 None => None,
                 Some(t) => Some(placement(ctx, &field, t)?),
             };
-            let shape = match &o.shape {
-                ShapeDesc::Mesh { .. } | ShapeDesc::Triangles { .. } => {
+            let shape = match (&o.shape, ahead.remove(&(g, j))) {
+                (ShapeDesc::Mesh { path, .. }, Some(a)) => {
+                    Shape::Mesh(Box::new(Mesh::from_ahead(ctx, &format!("{field}.shape"), path, a, xf.as_ref())?))
+                }
+                (ShapeDesc::Mesh { .. } | ShapeDesc::Triangles { .. }, _) => {
                     Shape::from_desc(ctx, &format!("{field}.shape"), &o.shape, xf.as_ref())?
                 }
-                ShapeDesc::Instance { .. } => {
+                (ShapeDesc::Instance { .. }, _) => {
                     return Err(ctx.err(
                         format!("{field}.shape"),
                         "groups do not nest: expected a Mesh or Triangles, not an Instance",
                     ));
                 }
-                _ => {
+                (_, _) => {
                     return Err(ctx.err(
                         format!("{field}.shape"),
                         "a group holds meshes: expected a Mesh or Triangles (place spheres, disks, quads, cuboids and planes as objects)",
                     ));
                 }
             };
-            let Shape::Mesh(mesh) = shape else { unreachable!("a Mesh or Triangles builds a mesh") };
+            let Shape::Mesh(mesh) = shape else {
+                return Err(ctx.err(format!("{field}.shape"), "expected a Mesh or Triangles"));
+            };
             let Some(mat) = &o.material else {
                 return Err(ctx.err(&field, "expected a `material` (a group's objects do not emit)"));
             };

@@ -121,6 +121,8 @@ pub(crate) struct Built {
     pub(crate) groups: Vec<(String, Vec<ObjectDesc>)>,
     /// Per group member: the PLY file its triangles came from (as `mesh_files`).
     pub(crate) group_files: Vec<Vec<Option<String>>>,
+    /// Per group member: where its `Shape` is (as `object_locs`).
+    pub(crate) group_locs: Vec<Vec<Loc>>,
     /// Per `ObjectBegin` name instanced so far: its group, or `None` when its
     /// instances are copies (see [`Parser::native_group`]).
     pub(crate) group_index: HashMap<String, Option<usize>>,
@@ -175,6 +177,7 @@ impl Default for Built {
             objects: Vec::new(),
             groups: Vec::new(),
             group_files: Vec::new(),
+            group_locs: Vec::new(),
             group_index: HashMap::new(),
             instanced: 0,
             mesh_files: Vec::new(),

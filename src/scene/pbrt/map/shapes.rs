@@ -183,6 +183,7 @@ impl Parser<'_> {
             Slot::Member(g, _) => {
                 self.built.groups[g].1.push(o);
                 self.built.group_files[g].push(mesh_file);
+                self.built.group_locs[g].push(at);
             }
         }
         Ok(())
@@ -217,12 +218,14 @@ impl Parser<'_> {
             }
             self.built.groups.push((unique, Vec::new()));
             self.built.group_files.push(Vec::new());
+            self.built.group_locs.push(Vec::new());
             for s in shapes {
                 self.place(s, None)?;
             }
             if self.built.groups[g].1.is_empty() {
                 self.built.groups.pop();
                 self.built.group_files.pop();
+                self.built.group_locs.pop();
             } else {
                 group = Some(g);
             }
