@@ -15,6 +15,7 @@ mod environment;
 mod furnace;
 mod fuzz;
 mod hostile;
+mod instances;
 mod lights;
 mod media;
 mod memory;

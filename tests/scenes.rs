@@ -95,7 +95,7 @@ fn readme_scene_example_loads() {
     // Paths in the example are relative to a scene in scenes/.
     let scene = rust_v::scene::load_scene_str(example, &root().join("scenes/readme-example.ron"), &Default::default())
         .unwrap_or_else(|e| panic!("README example: {e}"));
-    assert_eq!(scene.object_count(), 13);
+    assert_eq!(scene.object_count(), 14, "13 objects and one instance of a one-mesh group");
     assert_eq!((scene.objects[7].priority, scene.objects[8].priority), (1, 2), "priorities of the nested glass");
     assert_eq!(
         scene.lights.len(),

@@ -407,7 +407,7 @@ fn warn_no_effect(scene: &Scene) {
                 o.priority
             ));
         }
-        if !dielectric || matches!(o.shape, rust_v::shape::Shape::Mesh(_)) {
+        if !dielectric || matches!(o.shape, rust_v::shape::Shape::Mesh(_) | rust_v::shape::Shape::Instance(_)) {
             continue;
         }
         if let Some(first) = seen.insert(format!("{:?}", o.shape), i) {

@@ -335,6 +335,12 @@ impl Light {
             Shape::Quad(q) => flat(AreaLight::quad(q, radiance, two_sided), None)?,
             Shape::Cuboid(c) => flat(AreaLight::cuboid(c, radiance, two_sided), None)?,
             Shape::Mesh(m) => flat(AreaLight::mesh(m, radiance, two_sided), Some(m))?,
+            Shape::Instance(_) => {
+                return Err(check.err(
+                    format!("{field}.emission"),
+                    "an Instance cannot emit (its group's objects carry no emission); expected the emitter as an object of its own",
+                ));
+            }
             Shape::Plane(_) | Shape::Bubble(_) => {
                 return Err(check.err(
                     format!("{field}.emission"),

@@ -51,6 +51,13 @@ pub struct SceneDesc {
     pub materials: Materials,
     /// The objects (shapes with a material or an emission).
     pub objects: Vec<ObjectDesc>,
+    /// Named groups of objects in their own space, placed any number of times by
+    /// `Instance(group: "tree")` objects without copying their meshes:
+    /// `groups: { "tree": [ (shape: Mesh(path: "tree.ply"), material: "bark") ] }`.
+    /// Members are meshes (`Mesh`, `Triangles`) with a material; no emission, `interior`
+    /// or `exterior`.
+    #[serde(default)]
+    pub groups: NamedMap<Vec<ObjectDesc>>,
     /// Lights that are not objects (point lights).
     #[serde(default)]
     pub lights: Vec<LightDesc>,
@@ -114,6 +121,10 @@ impl Noun for MaterialDesc {
 
 impl Noun for MediumDesc {
     const NOUN: &'static str = "medium";
+}
+
+impl Noun for Vec<ObjectDesc> {
+    const NOUN: &'static str = "group";
 }
 
 impl<'de, T: Deserialize<'de> + Noun> Deserialize<'de> for NamedMap<T> {
@@ -501,6 +512,13 @@ pub enum ShapeDesc {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         translate: Option<V3>,
     },
+    /// The objects of a group in `groups`, placed by this object's `transform:` (which
+    /// may be a general `matrix:`); each member keeps its own material, so the object
+    /// takes no `material:`: `Instance(group: "tree")`.
+    Instance {
+        /// The group's name.
+        group: String,
+    },
 }
 
 /// A scale: one number or three.
@@ -572,6 +590,12 @@ pub struct TransformDesc {
     /// Translation (default none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub translate: Option<V3>,
+    /// A general affine map instead of the three above, as three rows of four
+    /// (`x' = m[0][0] x + m[0][1] y + m[0][2] z + m[0][3]`, ...): shears and mirrors.
+    /// Only for an `Instance`, a `Mesh` and `Triangles`; invertible and finite:
+    /// `matrix: ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0))`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix: Option<[[f32; 4]; 3]>,
 }
 
 /// A light that is not an object.

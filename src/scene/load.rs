@@ -12,7 +12,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::check::{Check, Input, MAX_MAGNITUDE};
-use super::desc::{CameraDesc, LensDesc, SceneDesc, ShapeDesc};
+use super::desc::{CameraDesc, LensDesc, ObjectDesc, SceneDesc, ShapeDesc, TransformDesc};
 use super::{Object, Scene, surround};
 use crate::bxdf::Bxdf;
 use crate::camera::lens_system::{D_LINE_NM, LensSystem};
@@ -23,7 +23,7 @@ use crate::io::{Fnv1a, fnv1a, read_input};
 use crate::light::{EnvironmentLight, Light};
 use crate::material;
 use crate::settings::{IntegratorKind, Settings, SettingsPatch};
-use crate::shape::{Mesh, MeshAhead, Placement, Shape};
+use crate::shape::{Mesh, MeshAhead, MeshInstance, Placement, Shape, Then};
 
 /// Loads the scene file at `path`; `overrides` (from the command line) take
 /// precedence over the file's `render` settings. The file must be a regular
@@ -188,7 +188,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     // thread pool; the loop below takes them in object order, so the scene,
     // its identity and the first error are those of loading one by one. A mesh
     // whose transform is invalid is left to the loop, which reports it.
-    let jobs: Vec<(usize, PathBuf, Transform, Option<Transform>)> = desc
+    let jobs: Vec<MeshJob<usize>> = desc
         .objects
         .iter()
         .enumerate()
@@ -197,9 +197,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
             let own = ctx.transform(&format!("objects[{i}].shape"), scale, rotate_deg, translate).ok()?;
             let then = match &o.transform {
                 None => None,
-                Some(t) => Some(
-                    ctx.transform(&format!("objects[{i}].transform"), &t.scale, &t.rotate_deg, &t.translate).ok()?,
-                ),
+                Some(t) => Some(placement(ctx, &format!("objects[{i}]"), t).ok()?.then()),
             };
             Some((i, ctx.dir.join(path), own, then))
         })
@@ -207,17 +205,24 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     let mut ahead: BTreeMap<usize, MeshAhead> =
         jobs.into_par_iter().map(|(i, path, own, then)| (i, Mesh::read_ahead(path, &own, then.as_ref()))).collect();
 
+    let groups = groups(ctx, &desc, &by_name)?;
     let mut objects = Vec::with_capacity(desc.objects.len());
+    // The second and further objects of each instance, after the file's objects (the
+    // first takes the instance's place, so `objects[i]` stays the file's object `i`).
+    let mut extra = Vec::new();
     let mut lights = Vec::new();
     for (i, o) in desc.objects.iter().enumerate() {
         let field = format!("objects[{i}]");
         let xf = match &o.transform {
             None => None,
-            Some(t) => {
-                let tf = format!("{field}.transform");
-                Some(Placement { t: ctx.transform(&tf, &t.scale, &t.rotate_deg, &t.translate)?, field: tf })
-            }
+            Some(t) => Some(placement(ctx, &field, t)?),
         };
+        if let ShapeDesc::Instance { group } = &o.shape {
+            let mut placed = instance(ctx, &field, o, group, xf.as_ref(), &groups)?.into_iter();
+            objects.extend(placed.next());
+            extra.extend(placed);
+            continue;
+        }
         let shape = match (&o.shape, ahead.remove(&i)) {
             (ShapeDesc::Mesh { path, .. }, Some(a)) => {
                 Shape::Mesh(Box::new(Mesh::from_ahead(ctx, &format!("{field}.shape"), path, a, xf.as_ref())?))
@@ -279,6 +284,8 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         };
         objects.push(Object { shape, material, light, priority: o.priority, interior, world: false });
     }
+    let extras = extra.len();
+    objects.append(&mut extra);
     for (i, l) in desc.lights.iter().enumerate() {
         lights.push(Light::from_desc(ctx, &format!("lights[{i}]"), l)?);
     }
@@ -290,6 +297,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
     }
     // The camera's medium: a volume around the whole scene (`surround`).
     let mut names: Vec<Option<&str>> = desc.objects.iter().map(|o| o.interior.as_deref()).collect();
+    names.extend(std::iter::repeat_n(None, extras));
     if let Some(name) = &desc.camera.medium {
         let m = media.get(name.as_str()).ok_or_else(|| {
             let known: Vec<&str> = media.keys().copied().collect();
@@ -349,6 +357,201 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         Some(lens) => lens_camera(ctx, c, lens, (eye, look_at, up), &settings)?,
     };
     Ok(Scene::new(objects, materials, textures, lights, camera, settings, 0))
+}
+
+/// An object's `transform:` (`field`: `objects[i]`), checked: scale, rotation and
+/// translation, or a general `matrix:` (exclusive with them, finite, invertible).
+fn placement(ctx: &Check<'_>, field: &str, t: &TransformDesc) -> Result<Placement> {
+    let tf = format!("{field}.transform");
+    let Some(rows) = &t.matrix else {
+        return Ok(Placement {
+            t: ctx.transform(&tf, &t.scale, &t.rotate_deg, &t.translate)?,
+            matrix: None,
+            field: tf,
+        });
+    };
+    let mf = format!("{tf}.matrix");
+    if t.scale.is_some() || t.rotate_deg.is_some() || t.translate.is_some() {
+        return Err(ctx.err(
+            &mf,
+            "not with `scale`, `rotate_deg` or `translate`: a matrix is the whole placement; expected one or the other",
+        ));
+    }
+    for (r, row) in rows.iter().enumerate() {
+        if let Some(c) = row.iter().position(|v| !(v.is_finite() && v.abs() <= MAX_MAGNITUDE)) {
+            return Err(ctx.err(
+                &mf,
+                format!("row {r}, column {c} is {}: expected finite numbers up to ±{MAX_MAGNITUDE:e}", row[c]),
+            ));
+        }
+    }
+    let col = |c: usize| Vec3::new(rows[0][c], rows[1][c], rows[2][c]);
+    let m = glam::Mat3::from_cols(col(0), col(1), col(2));
+    let det = m.determinant();
+    // Singular relative to the size of its columns (a matrix of tiny entries is fine).
+    let size = col(0).length() * col(1).length() * col(2).length();
+    let inverse = m.inverse();
+    if !(det.abs() > 1e-6 * size && det.is_finite() && inverse.is_finite()) {
+        return Err(ctx.err(
+            &mf,
+            format!(
+                "the matrix is singular (its linear part's determinant is {det:e}): expected an invertible placement"
+            ),
+        ));
+    }
+    Ok(Placement { t: Transform::default(), matrix: Some((m, col(3))), field: tf })
+}
+
+/// A mesh file to read ahead: its key, path, own transform and its object's placement.
+type MeshJob<K> = (K, PathBuf, Transform, Option<Then>);
+
+/// A group's members, built once in group space: the shared mesh, material and priority.
+type Group = Vec<(std::sync::Arc<Mesh>, u32, u32)>;
+
+/// The scene's `groups:`, each member checked (a mesh with a material; no emission,
+/// `interior` or `exterior`) and built once.
+fn groups(ctx: &Check<'_>, desc: &SceneDesc, materials: &BTreeMap<&str, u32>) -> Result<BTreeMap<String, Group>> {
+    // The groups' mesh files are read and built at once on the thread pool, as the
+    // objects' are (see `build`); the loop takes them in order.
+    let jobs: Vec<MeshJob<(usize, usize)>> = desc
+        .groups
+        .0
+        .iter()
+        .enumerate()
+        .flat_map(|(g, (name, members))| members.iter().enumerate().map(move |(j, o)| (g, name, j, o)))
+        .filter_map(|(g, name, j, o)| {
+            let ShapeDesc::Mesh { path, scale, rotate_deg, translate } = &o.shape else { return None };
+            let field = format!("groups.\"{name}\"[{j}]");
+            let own = ctx.transform(&format!("{field}.shape"), scale, rotate_deg, translate).ok()?;
+            let then = match &o.transform {
+                None => None,
+                Some(t) => Some(placement(ctx, &field, t).ok()?.then()),
+            };
+            Some(((g, j), ctx.dir.join(path), own, then))
+        })
+        .collect();
+    let mut ahead: BTreeMap<(usize, usize), MeshAhead> =
+        jobs.into_par_iter().map(|(k, path, own, then)| (k, Mesh::read_ahead(path, &own, then.as_ref()))).collect();
+    let mut out = BTreeMap::new();
+    for (g, (name, members)) in desc.groups.0.iter().enumerate() {
+        let gf = format!("groups.\"{name}\"");
+        if members.is_empty() {
+            return Err(ctx.err(&gf, "an empty group: expected at least one object"));
+        }
+        let mut group = Vec::with_capacity(members.len());
+        for (j, o) in members.iter().enumerate() {
+            let field = format!("{gf}[{j}]");
+            for (given, what) in [
+                (o.emission.is_some(), "emission"),
+                (o.interior.is_some(), "interior"),
+                (o.exterior.is_some(), "exterior"),
+            ] {
+                if given {
+                    return Err(ctx.err(
+                        format!("{field}.{what}"),
+                        format!("a group's object takes no `{what}:` (an instance is only a surface with a material, as in pbrt-v4); expected the object outside `groups`"),
+                    ));
+                }
+            }
+            let xf = match &o.transform {
+                None => None,
+                Some(t) => Some(placement(ctx, &field, t)?),
+            };
+            let shape = match (&o.shape, ahead.remove(&(g, j))) {
+                (ShapeDesc::Mesh { path, .. }, Some(a)) => {
+                    Shape::Mesh(Box::new(Mesh::from_ahead(ctx, &format!("{field}.shape"), path, a, xf.as_ref())?))
+                }
+                (ShapeDesc::Mesh { .. } | ShapeDesc::Triangles { .. }, _) => {
+                    Shape::from_desc(ctx, &format!("{field}.shape"), &o.shape, xf.as_ref())?
+                }
+                (ShapeDesc::Instance { .. }, _) => {
+                    return Err(ctx.err(
+                        format!("{field}.shape"),
+                        "groups do not nest: expected a Mesh or Triangles, not an Instance",
+                    ));
+                }
+                (_, _) => {
+                    return Err(ctx.err(
+                        format!("{field}.shape"),
+                        "a group holds meshes: expected a Mesh or Triangles (place spheres, disks, quads, cuboids and planes as objects)",
+                    ));
+                }
+            };
+            let Shape::Mesh(mesh) = shape else {
+                return Err(ctx.err(format!("{field}.shape"), "expected a Mesh or Triangles"));
+            };
+            let Some(mat) = &o.material else {
+                return Err(ctx.err(&field, "expected a `material` (a group's objects do not emit)"));
+            };
+            let material = *materials.get(mat.as_str()).ok_or_else(|| {
+                let known: Vec<&str> = materials.keys().copied().collect();
+                ctx.err(
+                    format!("{field}.material"),
+                    format!("unknown material \"{mat}\"; defined: {}", known.join(", ")),
+                )
+            })?;
+            group.push((std::sync::Arc::new(*mesh), material, o.priority));
+        }
+        out.insert(name.clone(), group);
+    }
+    Ok(out)
+}
+
+/// The objects of an `Instance(group: ...)` object at `field`: one per member of the
+/// group, sharing its mesh, placed by the object's transform `xf`; a placement that
+/// cancels large coordinates places a copy instead ([`MeshInstance::cancels`]).
+fn instance(
+    ctx: &Check<'_>,
+    field: &str,
+    o: &ObjectDesc,
+    name: &str,
+    xf: Option<&Placement>,
+    groups: &BTreeMap<String, Group>,
+) -> Result<Vec<Object>> {
+    for (given, what, why) in [
+        (o.material.is_some(), "material", "the group's objects carry their own materials"),
+        (
+            o.emission.is_some(),
+            "emission",
+            "an instance is only a surface (pbrt-v4 refuses area lights in instances too)",
+        ),
+        (o.interior.is_some(), "interior", "an instance bounds no medium"),
+        (o.exterior.is_some(), "exterior", "an instance bounds no medium"),
+        (o.priority != 0, "priority", "the group's objects carry their own priorities"),
+    ] {
+        if given {
+            return Err(ctx.err(format!("{field}.{what}"), format!("an Instance takes no `{what}:`: {why}")));
+        }
+    }
+    let group = groups.get(name).ok_or_else(|| {
+        let known: Vec<&str> = groups.keys().map(String::as_str).collect();
+        let known = if known.is_empty() { "none".to_string() } else { known.join(", ") };
+        ctx.err(format!("{field}.shape.group"), format!("unknown group \"{name}\"; defined: {known}"))
+    })?;
+    let (m, t) = xf.map_or((glam::Mat3::IDENTITY, Vec3::ZERO), Placement::affine);
+    let mut out = Vec::with_capacity(group.len());
+    for (j, (mesh, material, priority)) in group.iter().enumerate() {
+        let shape = if MeshInstance::cancels(mesh, m, t) {
+            let copy = mesh.placed_copy(m, t).map_err(|e| {
+                let at = xf.map_or(field.to_string(), |x| x.field.clone());
+                ctx.err(at, format!("placing groups.\"{name}\"[{j}]: {e}"))
+            })?;
+            Shape::Mesh(Box::new(copy))
+        } else {
+            let inst = MeshInstance::new(mesh.clone(), m, t);
+            let b = inst.bounds();
+            if ctx.vec(field, b.min.into()).is_err() || ctx.vec(field, b.max.into()).is_err() {
+                let at = xf.map_or(field.to_string(), |x| x.field.clone());
+                return Err(ctx.err(
+                    at,
+                    format!("the placement moves groups.\"{name}\"[{j}] out of range: expected coordinates up to ±{MAX_MAGNITUDE:e}"),
+                ));
+            }
+            Shape::Instance(Box::new(inst))
+        };
+        out.push(Object { shape, material: *material, light: None, priority: *priority, interior: None, world: false });
+    }
+    Ok(out)
 }
 
 /// The camera looking through the lens system `lens` of camera block `c`.

@@ -79,10 +79,12 @@ impl Mesh {
             }
         }
         let data = MeshData { positions, triangles: indices.to_vec(), normals, uvs: uvs.map(<[_]>::to_vec) };
-        Mesh::from_parts(data, &Transform::default(), xf.map(|x| &x.t), &Error::Settings).map_err(|e| match (e, xf) {
-            (Error::Setting { name, message }, Some(x)) => check.err(format!("{}.{name}", x.field), message),
-            (Error::Settings(message), _) => check.err(f("indices"), message),
-            (e, _) => check.err(field, e.to_string()),
+        Mesh::from_parts(data, &Transform::default(), xf.map(Placement::then).as_ref(), &Error::Settings).map_err(|e| {
+            match (e, xf) {
+                (Error::Setting { name, message }, Some(x)) => check.err(format!("{}.{name}", x.field), message),
+                (Error::Settings(message), _) => check.err(f("indices"), message),
+                (e, _) => check.err(field, e.to_string()),
+            }
         })
     }
 }

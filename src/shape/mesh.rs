@@ -3,13 +3,13 @@
 //! mesh's own [`WideBvh`], which also stores the triangles (four to a block, in leaf
 //! order); `Hit::prim` is a triangle's index in that order (its slot).
 
-use super::Placement;
+use super::{Placement, Then};
 use crate::io::{fnv1a, parse_mesh, read_input};
 use crate::scene::check::Check;
 use crate::scene::desc::{ScaleDesc, V3};
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 use super::bvh::{MAX_BLOCKS, TriangleHit, WideBvh};
 use crate::error::{Error, Result};
@@ -62,7 +62,7 @@ impl Mesh {
         data: MeshData,
         path: &Path,
         transform: &Transform,
-        then: Option<&Transform>,
+        then: Option<&Then>,
     ) -> Result<Mesh> {
         Mesh::from_parts(data, transform, then, &|m| Error::mesh(path, m))
     }
@@ -74,7 +74,7 @@ impl Mesh {
     pub(crate) fn from_parts(
         data: MeshData,
         transform: &Transform,
-        then: Option<&Transform>,
+        then: Option<&Then>,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
         let MeshData { positions, triangles, normals, uvs } = data;
@@ -104,11 +104,15 @@ impl Mesh {
         mut normals: Option<Vec<Vec3>>,
         uvs: Option<Vec<[f32; 2]>>,
         transform: &Transform,
-        then: Option<&Transform>,
+        then: Option<&Then>,
         err: &dyn Fn(String) -> Error,
     ) -> Result<Mesh> {
         let setting = |name, message| Error::Setting { name, message };
-        for t in std::iter::once(transform).chain(then) {
+        let srt = match then {
+            Some(Then::Srt(o)) => Some(o),
+            _ => None,
+        };
+        for t in std::iter::once(transform).chain(srt) {
             if !t.rotate_deg.is_finite() {
                 return Err(setting("rotate_deg", format!("expected finite angles, found {}", t.rotate_deg)));
             }
@@ -119,14 +123,25 @@ impl Mesh {
         // The mesh's own placement, then the object's (`then`): one affine map.
         let (m, translate) = match then {
             None => (transform.linear(), transform.translate),
-            Some(o) => {
+            Some(Then::Srt(o)) => {
                 let lo = o.linear();
                 (lo * transform.linear(), lo * transform.translate + o.translate)
             }
+            Some(Then::Affine(a, b)) => (*a * transform.linear(), *a * transform.translate + *b),
         };
         let det = m.determinant();
+        if let Some(Then::Affine(..)) = then
+            && !(det != 0.0 && det.is_finite())
+        {
+            return Err(setting(
+                "matrix",
+                format!(
+                    "the placement is singular in f32 (its linear part's determinant is {det:e}); expected an invertible matrix"
+                ),
+            ));
+        }
         if !(det != 0.0 && det.is_finite()) {
-            let scale = then.map_or(transform.scale, |o| o.scale * transform.scale);
+            let scale = srt.map_or(transform.scale, |o| o.scale * transform.scale);
             return Err(setting(
                 "scale",
                 format!("the scale {scale} makes the transform singular in f32 (its determinant is {det:e})"),
@@ -330,7 +345,8 @@ impl Mesh {
         xf: Option<&Placement>,
     ) -> Result<Mesh> {
         let transform = check.transform(field, scale, rotate_deg, translate)?;
-        let ahead = Mesh::read_ahead(check.dir.join(path), &transform, xf.map(|x| &x.t));
+        let then = xf.map(Placement::then);
+        let ahead = Mesh::read_ahead(check.dir.join(path), &transform, then.as_ref());
         Mesh::from_ahead(check, field, path, ahead, xf)
     }
 
@@ -339,7 +355,7 @@ impl Mesh {
     /// mesh of a scene at once on the thread pool, then [`Mesh::from_ahead`] in
     /// object order. The result (and the mesh's BVH) does not depend on the
     /// thread that made it.
-    pub(crate) fn read_ahead(path: PathBuf, transform: &Transform, then: Option<&Transform>) -> MeshAhead {
+    pub(crate) fn read_ahead(path: PathBuf, transform: &Transform, then: Option<&Then>) -> MeshAhead {
         let read = read_input(&path).map(|bytes| {
             let hash = fnv1a(&bytes);
             (hash, parse_mesh(bytes, &path).and_then(|data| Mesh::from_data_placed(data, &path, transform, then)))
@@ -368,6 +384,28 @@ impl Mesh {
         })
     }
 
+    /// A copy of this mesh placed by `x -> m x + t` (an instance that cannot share the
+    /// mesh, see [`super::MeshInstance::new`]): its triangles in storage order, with their
+    /// normals and uvs, built as a mesh placed by a `matrix:` is.
+    pub(crate) fn placed_copy(&self, m: Mat3, t: Vec3) -> Result<Mesh> {
+        let n = self.triangle_count() as u32;
+        let mut positions = Vec::with_capacity(3 * n as usize);
+        let mut normals = self.normals.as_ref().map(|_| Vec::with_capacity(3 * n as usize));
+        let mut uvs = self.uvs.as_ref().map(|_| Vec::with_capacity(3 * n as usize));
+        for k in 0..n {
+            positions.extend(self.triangle(k));
+            if let (Some(out), Some(ns)) = (normals.as_mut(), &self.normals) {
+                out.extend(self.vert_idx[k as usize].map(|i| ns[i as usize]));
+            }
+            if let (Some(out), Some(us)) = (uvs.as_mut(), &self.uvs) {
+                out.extend(self.vert_idx[k as usize].map(|i| us[i as usize]));
+            }
+        }
+        let indices = (0..n).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+        let then = Then::Affine(m, t);
+        Mesh::build(positions, indices, normals, uvs, &Transform::default(), Some(&then), &Error::Settings)
+    }
+
     /// A cuboid `[min, max]` placed by `t` as a closed mesh of 12 triangles, wound
     /// counter-clockwise seen from outside (outward normals: still a solid).
     pub(crate) fn cuboid(min: Vec3, max: Vec3, t: &Transform) -> Result<Mesh> {
@@ -383,7 +421,7 @@ impl Mesh {
             [4, 5, 7, 6], // +z
         ];
         let tris = faces.iter().flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]]).collect();
-        Mesh::build(corners, tris, None, None, &Transform::default(), Some(t), &|m| {
+        Mesh::build(corners, tris, None, None, &Transform::default(), Some(&Then::Srt(*t)), &|m| {
             Error::Settings(format!("cuboid: {m}"))
         })
     }

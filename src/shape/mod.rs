@@ -17,6 +17,7 @@ mod bvh;
 mod cuboid;
 mod disk;
 mod inline;
+mod instance;
 mod mesh;
 mod plane;
 mod quad;
@@ -30,6 +31,7 @@ pub use bubble::Bubble;
 pub use bvh::{Bvh, TriangleHit, WideBvh};
 pub use cuboid::Cuboid;
 pub use disk::Disk;
+pub use instance::{MAX_CANCELLATION, MeshInstance};
 pub use mesh::Mesh;
 pub(crate) use mesh::MeshAhead;
 pub use plane::Plane;
@@ -60,6 +62,8 @@ pub enum Shape {
     Quad(Quad),
     /// A triangle mesh with its own BVH.
     Mesh(Box<Mesh>),
+    /// A group's mesh shared by every instance of the group, placed by an affine map.
+    Instance(Box<MeshInstance>),
 }
 
 impl Shape {
@@ -74,6 +78,7 @@ impl Shape {
             Shape::Cuboid(s) => s.intersect(ray, t_max),
             Shape::Quad(s) => s.intersect(ray, t_max),
             Shape::Mesh(s) => s.intersect(ray, t_max),
+            Shape::Instance(s) => s.intersect(ray, t_max),
         }
     }
 
@@ -88,6 +93,7 @@ impl Shape {
             Shape::Cuboid(s) => s.occluded(ray, t_max),
             Shape::Quad(s) => s.occluded(ray, t_max),
             Shape::Mesh(s) => s.occluded(ray, t_max),
+            Shape::Instance(s) => s.occluded(ray, t_max),
         }
     }
 
@@ -101,8 +107,20 @@ impl Shape {
             Shape::Cuboid(s) => Some(s.bounds()),
             Shape::Quad(s) => Some(s.bounds()),
             Shape::Mesh(s) => Some(s.bounds()),
+            Shape::Instance(s) => Some(s.bounds()),
         }
     }
+}
+
+/// How an object places a mesh after the mesh's own transform: its `transform:` as
+/// scale, rotation and translation, or a general affine `matrix:` (a linear part and
+/// a translation; checked finite and non-singular by the loader).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Then {
+    /// Scale, rotate, translate.
+    Srt(Transform),
+    /// `x -> m x + t`.
+    Affine(glam::Mat3, Vec3),
 }
 
 /// An object's `transform:` ([`crate::scene::desc::TransformDesc`]), checked, with its
@@ -111,11 +129,26 @@ impl Shape {
 pub(crate) struct Placement {
     /// The field path of the `transform:` block.
     pub(crate) field: String,
-    /// The placement.
+    /// The placement as scale, rotation and translation (the identity with a `matrix`).
     pub(crate) t: Transform,
+    /// A general affine `matrix:` (linear part, translation), checked invertible.
+    pub(crate) matrix: Option<(glam::Mat3, Vec3)>,
 }
 
 impl Placement {
+    /// The placement for a mesh: the general matrix when given, else the transform.
+    pub(crate) fn then(&self) -> Then {
+        match self.matrix {
+            Some((m, t)) => Then::Affine(m, t),
+            None => Then::Srt(self.t),
+        }
+    }
+
+    /// The placement as a linear part and a translation.
+    pub(crate) fn affine(&self) -> (glam::Mat3, Vec3) {
+        self.matrix.unwrap_or((self.t.linear(), self.t.translate))
+    }
+
     /// The scale factor of a shape that takes only a uniform scale (`what`: "sphere").
     pub(crate) fn uniform_scale(&self, check: &Check, what: &str) -> Result<f32> {
         let s = self.t.scale;
@@ -170,6 +203,15 @@ impl Shape {
     /// object's transform `xf` when it has one; each shape is built and checked by its
     /// own type's `from_desc`.
     pub(crate) fn from_desc(check: &Check, field: &str, d: &ShapeDesc, xf: Option<&Placement>) -> Result<Shape> {
+        if let Some(x) = xf
+            && x.matrix.is_some()
+            && !matches!(d, ShapeDesc::Mesh { .. } | ShapeDesc::Triangles { .. } | ShapeDesc::Instance { .. })
+        {
+            return Err(check.err(
+                format!("{}.matrix", x.field),
+                "a general `matrix:` places only an Instance, a Mesh or Triangles; expected `scale`, `rotate_deg` and `translate` for this shape",
+            ));
+        }
         Ok(match d {
             ShapeDesc::Sphere { center, radius } => {
                 Shape::Sphere(Sphere::from_desc(check, field, *center, *radius, xf)?)
@@ -196,6 +238,9 @@ impl Shape {
             )?)),
             ShapeDesc::Mesh { path, scale, rotate_deg, translate } => {
                 Shape::Mesh(Box::new(Mesh::from_desc(check, field, path, scale, rotate_deg, translate, xf)?))
+            }
+            ShapeDesc::Instance { .. } => {
+                return Err(check.err(field, "an Instance places a group's objects: expected it in `objects`"));
             }
         })
     }

@@ -15,6 +15,9 @@
 //! | `Plane` | distance along the tangent of `Frame::from_z(normal)` from `point`, in scene units (not wrapped) | along the bitangent |
 //! | `Mesh` | the per-vertex texture coordinates interpolated, when the mesh has them (inline `Triangles(uvs: ...)`, OBJ `vt`, PLY `s t`, `u v`, `texture_u texture_v` or `texture_s texture_t`); else pbrt's default per triangle, (0, 0), (1, 0), (1, 1) at its three vertices | as u |
 //!
+//! An `Instance` (a group's mesh placed by an affine map) is parameterised as its
+//! mesh, at the hit's point in group space.
+//!
 //! A mesh hit's barycentric coordinates are recovered from the hit point and
 //! the triangle's vertices (the hit record does not carry them).
 
@@ -36,6 +39,7 @@ impl Shape {
             Shape::Cuboid(s) => cuboid_uv(s, hit.p),
             Shape::Quad(s) => quad_uv(s, hit.p),
             Shape::Mesh(m) => mesh_uv(m, hit.prim, hit.p),
+            Shape::Instance(i) => mesh_uv(i.mesh(), hit.prim, i.group_point(hit.p)),
         }
     }
 }

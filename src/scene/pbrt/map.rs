@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::io::{MeshData, fnv1a, parse_mesh, read_input};
 use crate::scene::desc::{
     CameraDesc, EnvironmentDesc, IorDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, PhaseDesc, ShapeDesc,
-    SpectrumDesc, V3, Wrap,
+    SpectrumDesc, TransformDesc, V3, Wrap,
 };
 use crate::settings::{IntegratorKind, SettingsPatch};
 
@@ -59,9 +59,18 @@ impl AreaLight {
     }
 }
 
+/// Where a placed shape goes: an object of the scene, or a member of a group.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Slot {
+    /// `objects[i]`.
+    Object(usize),
+    /// `groups[g]`'s member `j`.
+    Member(usize, usize),
+}
+
 /// A `plymesh` whose file is read after parsing ([`Parser::resolve_plys`]).
 struct PendingPly {
-    object: usize,
+    slot: Slot,
     file: String,
     floc: Loc,
     loc: Loc,
@@ -107,6 +116,18 @@ pub(crate) struct Built {
     pub(crate) materials: Vec<(String, MaterialDesc)>,
     textures: HashMap<String, Tex>,
     pub(crate) objects: Vec<ObjectDesc>,
+    /// Native instancing's groups (`ObjectBegin`s whose shapes are all meshes without
+    /// emission or media), in order of first instance: their members in object space.
+    pub(crate) groups: Vec<(String, Vec<ObjectDesc>)>,
+    /// Per group member: the PLY file its triangles came from (as `mesh_files`).
+    pub(crate) group_files: Vec<Vec<Option<String>>>,
+    /// Per group member: where its `Shape` is (as `object_locs`).
+    pub(crate) group_locs: Vec<Vec<Loc>>,
+    /// Per `ObjectBegin` name instanced so far: its group, or `None` when its
+    /// instances are copies (see [`Parser::native_group`]).
+    pub(crate) group_index: HashMap<String, Option<usize>>,
+    /// Objects placed by instances so far, against [`MAX_INSTANCED`].
+    instanced: usize,
     /// Per object: the PLY file (as written in the scene) its triangles came from.
     pub(crate) mesh_files: Vec<Option<String>>,
     /// Per object: where its `Shape` is.
@@ -133,14 +154,19 @@ pub(crate) struct Built {
     /// The outside medium at the `Camera` directive and its place.
     pub(crate) camera_medium: Option<(String, Loc)>,
     anonymous: usize,
-    /// Triangles placed so far (copies of instances included), against [`MAX_TRIANGLES`].
+    /// Triangles placed so far (copied instances included), against [`MAX_TRIANGLES`].
     triangles: usize,
 }
 
-/// The most triangles a pbrt scene may expand to (instances are copies, `loopsubdiv`
-/// multiplies by 4 per level): about 1.6 GB of positions and indices at most, so a
-/// small hostile file cannot exhaust memory.
+/// The most triangles a pbrt scene may expand to (unique triangles: a group's meshes
+/// count once however often it is instanced; copied instances count every copy;
+/// `loopsubdiv` multiplies by 4 per level): about 1.6 GB of positions and indices at
+/// most, so a small hostile file cannot exhaust memory.
 pub(crate) const MAX_TRIANGLES: usize = 1 << 26;
+
+/// The most objects a pbrt scene's native instances may place (one per member of the
+/// group per `ObjectInstance`, about 200 bytes each): 200 MB at most.
+pub(crate) const MAX_INSTANCED: usize = 1 << 20;
 
 impl Default for Built {
     fn default() -> Self {
@@ -149,6 +175,11 @@ impl Default for Built {
             materials: Vec::new(),
             textures: HashMap::new(),
             objects: Vec::new(),
+            groups: Vec::new(),
+            group_files: Vec::new(),
+            group_locs: Vec::new(),
+            group_index: HashMap::new(),
+            instanced: 0,
             mesh_files: Vec::new(),
             object_locs: Vec::new(),
             lights: Vec::new(),

@@ -31,6 +31,8 @@ pub(crate) struct Imported {
     pub(crate) warnings: Vec<String>,
     /// Per object: the PLY file its triangles came from, if any.
     pub(crate) mesh_files: Vec<Option<String>>,
+    /// Per group member: the PLY file its triangles came from, if any.
+    pub(crate) group_files: Vec<Vec<Option<String>>>,
     /// Where the description's objects and environment come from (see [`locate`]).
     pub(crate) places: Places,
 }
@@ -41,14 +43,18 @@ type Place = (PathBuf, usize, usize);
 /// Where parts of an imported description come from.
 #[derive(Default)]
 pub(crate) struct Places {
-    /// Per object: its `Shape` directive.
+    /// Per object: its `Shape` directive (its `ObjectInstance` for an instance).
     objects: Vec<Place>,
+    /// Per group: its name and each member's `Shape` directive.
+    groups: Vec<(String, Vec<Place>)>,
     /// The infinite light's `LightSource` (its `filename` for a map).
     environment: Option<Place>,
 }
 
 /// An error of the scene built from a pbrt file about `objects[i]` (an `exterior:`
-/// that disagrees with the volumes around the shape, a grid medium under `whitted`)
+/// that disagrees with the volumes around the shape, a grid medium under `whitted`, an
+/// instance's placement) or a group's member `groups."name"[j]` (a mesh with no valid
+/// triangle)
 /// or about the `environment` (a map that is not square, black or unreadable),
 /// moved to the directive it came from, the field kept in the message; any other
 /// error as it is.
@@ -56,10 +62,15 @@ pub(crate) fn locate(places: &Places, e: Error) -> Error {
     let Error::Scene { path, position: None, field, message } = e else { return e };
     let index =
         field.strip_prefix("objects[").and_then(|r| r.split_once(']')).and_then(|(i, _)| i.parse::<usize>().ok());
-    let place = match index {
-        Some(i) => places.objects.get(i),
-        None if field.starts_with("environment") => places.environment.as_ref(),
-        None => None,
+    let member = field
+        .strip_prefix("groups.\"")
+        .and_then(|r| r.split_once("\"["))
+        .and_then(|(name, r)| Some((name, r.split_once(']')?.0.parse::<usize>().ok()?)));
+    let place = match (index, member) {
+        (Some(i), _) => places.objects.get(i),
+        (None, Some((name, j))) => places.groups.iter().find(|(n, _)| n == name).and_then(|(_, p)| p.get(j)),
+        (None, None) if field.starts_with("environment") => places.environment.as_ref(),
+        (None, None) => None,
     };
     match place {
         Some((file, line, col)) => Error::Scene {
@@ -107,6 +118,12 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
     let place = |l: &parser::Loc| (p.files[l.file].clone(), l.line, l.col);
     let places = Places {
         objects: b.object_locs.iter().map(place).collect(),
+        groups: b
+            .groups
+            .iter()
+            .zip(&b.group_locs)
+            .map(|((n, _), l)| (n.clone(), l.iter().map(place).collect()))
+            .collect(),
         environment: b.environment_loc.as_ref().map(place),
     };
     Ok(Imported {
@@ -116,11 +133,13 @@ pub(crate) fn import(ctx: &Check<'_>, path: &Path, text: &str, strict: bool) -> 
             materials: NamedMap(b.materials),
             media: NamedMap(b.media),
             objects: b.objects,
+            groups: NamedMap(b.groups),
             lights: b.lights,
             environment: b.environment,
         },
         warnings,
         mesh_files: b.mesh_files,
+        group_files: b.group_files,
         places,
     })
 }

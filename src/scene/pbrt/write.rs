@@ -5,6 +5,8 @@
 //! (placed in world space by the importer) are written to a binary PLY beside the
 //! output (`NAME-mesh-K.ply`, float32 positions, normals and uvs exactly as
 //! loaded) and referenced as `Mesh(path: ...)`; inline `trianglemesh` data stays inline.
+//! Instanced objects (`ObjectBegin`/`ObjectInstance`) are written as `groups:` and
+//! `Instance` objects, a group's PLY triangles as `NAME-group-G-mesh-J.ply`.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -57,6 +59,8 @@ struct Out<'a> {
     #[serde(skip_serializing_if = "is_empty")]
     media: &'a NamedMap<MediumDesc>,
     objects: &'a [ObjectDesc],
+    #[serde(skip_serializing_if = "no_groups")]
+    groups: &'a NamedMap<Vec<ObjectDesc>>,
     #[serde(skip_serializing_if = "<[_]>::is_empty")]
     lights: &'a [LightDesc],
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -65,6 +69,27 @@ struct Out<'a> {
 
 fn is_empty(m: &&NamedMap<MediumDesc>) -> bool {
     m.0.is_empty()
+}
+
+fn no_groups(m: &&NamedMap<Vec<ObjectDesc>>) -> bool {
+    m.0.is_empty()
+}
+
+/// Writes the triangles of `o` (read from a PLY file by the import) to the binary PLY
+/// `name` in `out_dir` and makes `o` refer to it.
+fn write_mesh(o: &mut ObjectDesc, out_dir: &Path, name: String, written: &mut Vec<PathBuf>) -> Result<()> {
+    let ShapeDesc::Triangles { positions, indices, normals, uvs } = &o.shape else { return Ok(()) };
+    let mesh = MeshData {
+        positions: positions.iter().map(|p| glam::Vec3::from(*p)).collect(),
+        triangles: indices.clone(),
+        normals: normals.as_ref().map(|n| n.iter().map(|v| glam::Vec3::from(*v)).collect()),
+        uvs: uvs.clone(),
+    };
+    let path = out_dir.join(&name);
+    write_atomic(&path, &ply_bytes(&mesh))?;
+    written.push(path);
+    o.shape = ShapeDesc::Mesh { path: name, scale: None, rotate_deg: None, translate: None };
+    Ok(())
 }
 
 fn render(p: &SettingsPatch) -> Render {
@@ -176,7 +201,7 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         Error::scene_field(scene, "", format!("byte {} is not UTF-8; expected UTF-8 text", e.valid_up_to()))
     })?;
     let ctx = Check::new(scene);
-    let Imported { mut desc, warnings, mesh_files, .. } = super::import(&ctx, scene, text, strict)?;
+    let Imported { mut desc, warnings, mesh_files, group_files, .. } = super::import(&ctx, scene, text, strict)?;
     let out_dir = crate::io::parent_dir(output).to_path_buf();
     let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
     let mut written = Vec::new();
@@ -184,18 +209,16 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         if let Some(e) = o.emission.as_mut() {
             rebase(e, &ctx.dir, &out_dir);
         }
-        let (Some(_), ShapeDesc::Triangles { positions, indices, normals, uvs }) = (file, &o.shape) else { continue };
-        let mesh = MeshData {
-            positions: positions.iter().map(|p| glam::Vec3::from(*p)).collect(),
-            triangles: indices.clone(),
-            normals: normals.as_ref().map(|n| n.iter().map(|v| glam::Vec3::from(*v)).collect()),
-            uvs: uvs.clone(),
-        };
-        let name = format!("{stem}-mesh-{k}.ply");
-        let path = out_dir.join(&name);
-        write_atomic(&path, &ply_bytes(&mesh))?;
-        written.push(path);
-        o.shape = ShapeDesc::Mesh { path: name, scale: None, rotate_deg: None, translate: None };
+        if file.is_some() {
+            write_mesh(o, &out_dir, format!("{stem}-mesh-{k}.ply"), &mut written)?;
+        }
+    }
+    for (g, ((_, members), files)) in desc.groups.0.iter_mut().zip(&group_files).enumerate() {
+        for (j, (o, file)) in members.iter_mut().zip(files).enumerate() {
+            if file.is_some() {
+                write_mesh(o, &out_dir, format!("{stem}-group-{g}-mesh-{j}.ply"), &mut written)?;
+            }
+        }
     }
     // A `uniformgrid`'s density, made in memory by the import, as a file beside the output.
     for (k, (_, m)) in desc.media.0.iter_mut().filter(|(_, m)| matches!(m, MediumDesc::Grid { .. })).enumerate() {
@@ -236,6 +259,7 @@ pub fn convert(scene: &Path, output: &Path, strict: bool) -> Result<(Vec<String>
         materials: &desc.materials,
         media: &desc.media,
         objects: &desc.objects,
+        groups: &desc.groups,
         lights: &desc.lights,
         environment: &desc.environment,
     };

@@ -8,13 +8,23 @@ impl Parser<'_> {
 
     /// A `Shape` placed by `instance · rec.ctm` (then the mirror `M`).
     pub(crate) fn shape(&mut self, rec: &ShapeRec, instance: DMat4) -> Result<()> {
+        self.place(rec, Some(instance))
+    }
+
+    /// The `Shape` `rec` placed by `instance · rec.ctm` then the mirror `M` as an object,
+    /// or with `instance` None by `rec.ctm` alone as a member of the last group.
+    fn place(&mut self, rec: &ShapeRec, instance: Option<DMat4>) -> Result<()> {
         let ps = &rec.params;
         let at = rec.loc;
-        let x = self.built.mirror * instance * rec.ctm;
+        let x = match instance {
+            Some(i) => self.built.mirror * i * rec.ctm,
+            None => rec.ctm,
+        };
         let lin = DMat3::from_mat4(x);
         // pbrt's own `reverseOrientation ^ transformSwapsHandedness` (without the mirror `M`),
         // which flips the normal of its quadrics at intersections.
-        let quadric_flip = rec.reverse ^ (DMat3::from_mat4(instance * rec.ctm).determinant() < 0.0);
+        let quadric_flip =
+            rec.reverse ^ (DMat3::from_mat4(instance.unwrap_or(DMat4::IDENTITY) * rec.ctm).determinant() < 0.0);
         let what = format!("Shape \"{}\"", rec.ty);
         let mut mesh_file = None;
         let mut pending = None;
@@ -130,10 +140,16 @@ impl Parser<'_> {
         };
         let emission = rec.area.as_ref().map(|a| a.emission(area));
         let two_sided = rec.area.as_ref().is_some_and(|a| a.two_sided);
+        let slot = match instance {
+            Some(_) => Slot::Object(self.built.objects.len()),
+            None => {
+                let g = self.built.groups.len() - 1;
+                Slot::Member(g, self.built.groups[g].1.len())
+            }
+        };
         if let Some((file, floc)) = pending {
-            let object = self.built.objects.len();
             self.built.pending.push(PendingPly {
-                object,
+                slot,
                 file,
                 floc,
                 loc: at,
@@ -148,7 +164,7 @@ impl Parser<'_> {
         if let Some(name) = exterior {
             self.built.exteriors.push((self.built.objects.len(), name, at));
         }
-        self.built.objects.push(ObjectDesc {
+        let o = ObjectDesc {
             shape,
             material,
             emission,
@@ -157,8 +173,96 @@ impl Parser<'_> {
             transform: None,
             interior: None,
             exterior: None,
+        };
+        match slot {
+            Slot::Object(_) => {
+                self.built.objects.push(o);
+                self.built.mesh_files.push(mesh_file);
+                self.built.object_locs.push(at);
+            }
+            Slot::Member(g, _) => {
+                self.built.groups[g].1.push(o);
+                self.built.group_files[g].push(mesh_file);
+                self.built.group_locs[g].push(at);
+            }
+        }
+        Ok(())
+    }
+
+    /// The group of the `ObjectBegin` `name` with shapes `shapes`, built at its first
+    /// instance: its meshes in object space (placed by their CTMs). `None` when its
+    /// instances are copies instead: a shape emits, has a `MediumInterface` or is not a
+    /// mesh (pbrt-v4 refuses area lights in instances; rust-v's groups hold meshes
+    /// without media), or every shape was left out.
+    pub(crate) fn native_group(&mut self, name: &str, shapes: &[ShapeRec]) -> Result<Option<usize>> {
+        if let Some(g) = self.built.group_index.get(name) {
+            return Ok(*g);
+        }
+        let mesh = |s: &ShapeRec| matches!(s.ty.as_str(), "plymesh" | "trianglemesh" | "bilinearmesh" | "loopsubdiv");
+        let native = !shapes.is_empty()
+            && shapes.iter().all(|s| {
+                mesh(s)
+                    && s.area.is_none()
+                    && s.inside.is_empty()
+                    && s.outside.is_empty()
+                    && !matches!(s.material, MatRef::Interface)
+            });
+        let mut group = None;
+        if native {
+            let g = self.built.groups.len();
+            let mut unique = name.to_string();
+            let mut k = 2;
+            while self.built.groups.iter().any(|(n, _)| *n == unique) {
+                unique = format!("{name} ({k})");
+                k += 1;
+            }
+            self.built.groups.push((unique, Vec::new()));
+            self.built.group_files.push(Vec::new());
+            self.built.group_locs.push(Vec::new());
+            for s in shapes {
+                self.place(s, None)?;
+            }
+            if self.built.groups[g].1.is_empty() {
+                self.built.groups.pop();
+                self.built.group_files.pop();
+                self.built.group_locs.pop();
+            } else {
+                group = Some(g);
+            }
+        }
+        self.built.group_index.insert(name.to_string(), group);
+        Ok(group)
+    }
+
+    /// An `ObjectInstance` of group `g` under the CTM `ctm`: an `Instance` object placed
+    /// by the matrix `M · ctm` (the mirror included).
+    pub(crate) fn instance(&mut self, g: usize, ctm: DMat4, at: Loc) -> Result<()> {
+        self.built.instanced += self.built.groups[g].1.len();
+        if self.built.instanced > MAX_INSTANCED {
+            return Err(self.err(
+                at,
+                format!("the instances place more than {MAX_INSTANCED} objects: expected fewer ObjectInstances"),
+            ));
+        }
+        let x = self.built.mirror * ctm;
+        let transform = (x != DMat4::IDENTITY).then(|| {
+            let row = |r: usize| {
+                let v = x.row(r);
+                [v.x as f32 + 0.0, v.y as f32 + 0.0, v.z as f32 + 0.0, v.w as f32 + 0.0]
+            };
+            TransformDesc { matrix: Some([row(0), row(1), row(2)]), ..TransformDesc::default() }
         });
-        self.built.mesh_files.push(mesh_file);
+        self.built.objects.push(ObjectDesc {
+            shape: ShapeDesc::Instance { group: self.built.groups[g].0.clone() },
+            material: None,
+            emission: None,
+            two_sided: false,
+            priority: 0,
+            transform,
+            interior: None,
+            exterior: None,
+        });
+        self.built.mesh_files.push(None);
         self.built.object_locs.push(at);
         Ok(())
     }
@@ -218,7 +322,10 @@ impl Parser<'_> {
         for (p, r) in pending.iter().zip(placed) {
             let (shape, area) = r.map_err(|m| self.err(p.loc, format!("Shape \"plymesh\" \"{}\": {m}", p.file)))?;
             self.count_triangles(&shape, p.loc)?;
-            let o = &mut self.built.objects[p.object];
+            let o = match p.slot {
+                Slot::Object(i) => &mut self.built.objects[i],
+                Slot::Member(g, j) => &mut self.built.groups[g].1[j],
+            };
             o.shape = shape;
             if let Some(a) = &p.area {
                 o.emission = Some(a.emission(area));

@@ -326,6 +326,8 @@ impl Parser<'_> {
             }
             "ObjectEnd" => match self.object.take() {
                 Some((name, shapes, _)) => {
+                    // A redefined object is a new group at its next instance.
+                    self.built.group_index.remove(&name);
                     self.objects.insert(name, shapes);
                     if let Some((s, _, _)) = self.saved.pop() {
                         self.state = s;
@@ -345,13 +347,18 @@ impl Parser<'_> {
                     known.sort();
                     return Err(self.err(at, format!("unknown object \"{name}\"; defined: {}", known.join(", "))));
                 };
-                self.note(
-                    at,
-                    "ObjectInstance: instancing is not native yet; each instance is a copy of the object's shapes",
-                );
                 let ctm = self.state.ctm;
-                for s in &shapes {
-                    self.shape(s, ctm)?;
+                match self.native_group(&name, &shapes)? {
+                    Some(g) => self.instance(g, ctm, at)?,
+                    None => {
+                        self.note(
+                            at,
+                            "ObjectInstance: an object with an emitting shape, a MediumInterface or a shape other than a mesh is placed as copies of its shapes",
+                        );
+                        for s in &shapes {
+                            self.shape(s, ctm)?;
+                        }
+                    }
                 }
             }
             _ => unreachable!("world directives are listed in `directive`"),
