@@ -114,7 +114,11 @@ pub(crate) fn check_exteriors(
         if found_name != Some(want) {
             let what = match found {
                 None => "vacuum".to_string(),
-                Some(v) if v.object as usize >= descs.len() => "the camera's medium".to_string(),
+                Some(v) if objects[v.object as usize].world => "the camera's medium".to_string(),
+                // Objects past the file's own are the further members of instances.
+                Some(v) if v.object as usize >= descs.len() => {
+                    "the clear or absorbing inside of a group member placed by an `Instance`".to_string()
+                }
                 Some(v) => match names[v.object as usize] {
                     Some(n) => format!("\"{n}\", the interior of objects[{}]", v.object),
                     None => format!("the clear or absorbing inside of objects[{}]", v.object),
