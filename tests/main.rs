@@ -24,6 +24,7 @@ mod output;
 mod pbrt;
 mod pbrt_envmap;
 mod pbrt_media;
+mod pbrt_real;
 mod sampler;
 mod scenes;
 mod sensor;
