@@ -56,7 +56,12 @@ impl Parser<'_> {
         if let Some((s, loc)) = self.string(ps, "sensor")?
             && s != "cie1931"
         {
-            self.warn(loc, format!("Film \"sensor\" \"{s}\" is not supported: rendered with the CIE 1931 observer"))?;
+            self.warn(
+                loc,
+                format!(
+                    "Film \"sensor\" \"{s}\": pbrt's measured camera curves are not shipped with rust-v: rendered with the CIE 1931 observer (give the camera's curves with --sensor FILE.csv, docs/sensors.md)"
+                ),
+            )?;
         }
         for ignored in ["iso", "exposuretime", "whitebalance", "maxcomponentvalue", "savefp16", "diagonal"] {
             if let Some(p) = self.param(ps, ignored) {
