@@ -19,6 +19,7 @@ mod lights;
 mod media;
 mod memory;
 mod metrics;
+mod mix;
 mod output;
 mod pbrt;
 mod pbrt_envmap;

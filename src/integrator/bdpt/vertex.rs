@@ -51,7 +51,8 @@ pub(super) struct Vertex {
     /// At a dielectric's surface, the material of the medium on its outside
     /// (`None`: vacuum, or not a dielectric).
     pub(super) outside: Option<u32>,
-    /// The surface coordinates, where the material is textured (else zero).
+    /// The surface coordinates, where the material is textured or a `Mix`
+    /// (else zero).
     pub(super) uv: Vec2,
 }
 
@@ -160,18 +161,19 @@ pub(super) fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 
     if c.is_finite() { c } else { 0.0 }
 }
 
-/// The material of object `o`, untextured: for what no texture changes
-/// (delta, dispersive, black).
+/// The material at surface vertex `v` of object `o`, untextured: for what no
+/// texture changes (delta, dispersive, black). A `Mix` resolves at the
+/// vertex's point, as [`bsdf_at`] does (a scene without one pays a branch).
 #[inline]
-pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
-    scene.bsdf(o)
+pub(super) fn material<'s>(scene: &'s Scene, o: u32, v: &Vertex) -> &'s Bxdf {
+    &scene.materials[scene.material_at(o, v.p(), v.uv) as usize]
 }
 
-/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the
-/// vertex's (u, v), built in `slot`).
+/// The BSDF at surface vertex `v` of object `o` (a `Mix` resolved at its
+/// point, its texture evaluated at the vertex's (u, v), built in `slot`).
 #[inline(always)]
 pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex, slot: &'s mut Option<Bxdf>) -> &'s Bxdf {
-    scene.bsdf_uv(o, v.uv, slot)
+    scene.bsdf_uv(o, v.p(), v.uv, slot)
 }
 
 /// True when a connection can end at `v`: a surface whose material has a
@@ -181,7 +183,7 @@ pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex, slot: &'s mut Op
 #[inline]
 pub(super) fn connectible(scene: &Scene, v: &Vertex) -> bool {
     match v.kind {
-        Kind::Surface(o) => !material(scene, o).is_delta(),
+        Kind::Surface(o) => !material(scene, o, v).is_delta(),
         Kind::Light(_) | Kind::Camera | Kind::Medium(_) => true,
     }
 }
@@ -190,7 +192,7 @@ pub(super) fn connectible(scene: &Scene, v: &Vertex) -> bool {
 /// medium outside it disperses).
 #[inline]
 pub(super) fn is_dispersive(scene: &Scene, v: &Vertex) -> bool {
-    matches!(v.kind, Kind::Surface(o) if material(scene, o).dispersion_within(outside(scene, v.outside)).is_some())
+    matches!(v.kind, Kind::Surface(o) if material(scene, o, v).dispersion_within(outside(scene, v.outside)).is_some())
 }
 
 /// The medium outside a dielectric vertex, from its material index.

@@ -66,7 +66,7 @@ impl Walk {
             let hit = si.hit;
             let uv = if scene.needs_uv(si.object) { scene.uv(&si) } else { glam::Vec2::ZERO };
             let mut slot = None;
-            let bxdf = scene.bsdf_uv(si.object, uv, &mut slot);
+            let bxdf = scene.bsdf_uv(si.object, hit.p, uv, &mut slot);
             // The medium the segment ran in: Beer-Lambert where it only absorbs;
             // where it scatters (or is a grid), a distance by spectral MIS, and a
             // scattering event before the surface is a medium vertex.
