@@ -144,10 +144,12 @@ fn sphere_light(materials: &str, ball: &str) -> String {
 /// Path tracing and BDPT agree on a Mix of a diffuse and a mirror material:
 /// the choice is the same for every strategy at a vertex (BDPT's
 /// connections, which may end only where the diffuse material is chosen,
-/// and its MIS weights see what its walks saw; evaluating a connection with
-/// a choice of its own, a hash of a point 1e-3 away, fails this: a block of
-/// the sphere 0.255 differed by 0.071 against a tolerance of 0.058; as
-/// written the worst block differs by 2.9 standard errors). Per 4x4 block of a 32x32
+/// and its MIS weights see what its walks saw; a connection that evaluated
+/// the BSDF with a choice of its own, a hash of a point 1e-3 away, while the
+/// walk and the test of whether a vertex can be connected used the vertex's,
+/// failed this when tried: a block of the sphere of 0.255 differed by 0.071
+/// against a tolerance of 0.058; as written the worst block differs by 2.9
+/// standard errors). Per 4x4 block of a 32x32
 /// image at 256 spp, the mean of the per-pixel differences path − BDPT (the
 /// image's structure cancels; what is left is the two methods' noise) within
 /// 5 standard errors of that mean (from the spread of the 16 differences)

@@ -108,17 +108,30 @@ impl Scene {
         t.apply(self.bsdf(object), uv)
     }
 
-    /// The BSDF of object `object` at point `p`, surface coordinates `uv` (as
-    /// [`Scene::bsdf_in`], for a path vertex that kept its point and (u, v)).
+    /// The BSDF of material `m` (a hit's, from [`Scene::material_at`]) at
+    /// surface coordinates `uv` (as [`Scene::bsdf_in`], for a path vertex
+    /// that resolved its material and kept its (u, v)).
     #[inline(always)]
-    pub fn bsdf_uv<'a>(&'a self, object: u32, p: Vec3, uv: Vec2, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
-        if !self.mixes.is_empty() {
-            return self.mixed(object, p, uv, slot);
+    pub fn bsdf_of<'a>(&'a self, m: u32, uv: Vec2, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
+        match self.material_texture(m) {
+            Some(t) => slot.insert(self.textured_material(m, t, uv)),
+            None => &self.materials[m as usize],
         }
-        match self.texture(object) {
-            Some(t) => slot.insert(self.textured(object, t, uv)),
-            None => self.bsdf(object),
+    }
+
+    /// Material `m`'s lobe with textures `t` evaluated at `uv` (out of line).
+    #[inline(never)]
+    fn textured_material(&self, m: u32, t: &MaterialTextures, uv: Vec2) -> Bxdf {
+        t.apply(&self.materials[m as usize], uv)
+    }
+
+    /// The textures of material `m`, if it has any.
+    #[inline]
+    fn material_texture(&self, m: u32) -> Option<&MaterialTextures> {
+        if self.textures.is_empty() {
+            return None;
         }
+        self.textures[m as usize].as_ref()
     }
 
     /// The material a hit on object `object` at point `p`, surface
@@ -135,11 +148,7 @@ impl Scene {
     /// line): the chosen material's, its textures evaluated at `uv`.
     #[inline(never)]
     fn mixed<'a>(&'a self, object: u32, p: Vec3, uv: Vec2, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
-        let m = self.material_at(object, p, uv) as usize;
-        match self.textures.get(m).and_then(Option::as_ref) {
-            Some(t) => slot.insert(t.apply(&self.materials[m], uv)),
-            None => &self.materials[m],
-        }
+        self.bsdf_of(self.material_at(object, p, uv), uv, slot)
     }
 
     /// The materials a hit with material `*m` may have: `m` itself, or a
