@@ -20,6 +20,7 @@ mod lights;
 mod media;
 mod memory;
 mod metrics;
+mod mix;
 mod output;
 mod pbrt;
 mod pbrt_envmap;

@@ -887,3 +887,56 @@ fn killeroo_simple_from_pbrt_v4_scenes_loads_and_renders() {
     let film = film_of(&scene);
     assert!(film.mean_xyz().iter().map(|p| p[1]).sum::<f64>() > 0.01, "the scene is lit");
 }
+
+/// pbrt's `mix` imports as a `Mix` without a warning: its materials by name
+/// (either may be a mix), its amount a float or a constant float texture, an
+/// amount outside [0, 1] clamped (pbrt's choice, second where amount ≥ u for
+/// u in [0, 1), makes 1.5 the second everywhere); `convert` writes the Mix,
+/// and the RON renders bit for bit like the `.pbrt`. A mix of an unknown
+/// material or of an interface is one error naming the line.
+#[test]
+fn mix_imports_as_a_mix_and_converts_bit_identically() {
+    let d = temp_dir("pbrt-mix");
+    let body = "LightSource \"point\" \"point3 from\" [0 2 4] \"float power\" 400\n\
+        MakeNamedMaterial \"red\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.1 0.1]\n\
+        MakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.1\n\
+        Texture \"amt\" \"float\" \"constant\" \"float value\" 0.3\n\
+        MakeNamedMaterial \"worn\" \"string type\" \"mix\" \"string materials\" [\"red\" \"gold\"] \"texture amount\" \"amt\"\n\
+        MakeNamedMaterial \"over\" \"string type\" \"mix\" \"string materials\" [\"worn\" \"red\"] \"float amount\" 1.5\n\
+        AttributeBegin\n NamedMaterial \"worn\"\n Translate -0.6 0 0\n Shape \"sphere\" \"float radius\" 0.5\nAttributeEnd\n\
+        AttributeBegin\n NamedMaterial \"over\"\n Translate 0.6 0 0\n Shape \"sphere\" \"float radius\" 0.5\nAttributeEnd\n";
+    let p = write(&d, "mix.pbrt", &format!("{HEAD}{body}"));
+    let (desc, warnings) = read_pbrt(&p, true).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let mix = |name: &str| match desc.materials.0.iter().find(|(n, _)| n == name).map(|(_, m)| m) {
+        Some(MaterialDesc::Mix { materials, amount }) => (materials.clone(), amount.clone()),
+        other => panic!("{name}: {other:?}"),
+    };
+    use rust_v::scene::desc::ScalarDesc;
+    assert_eq!(mix("worn"), (("red".to_string(), "gold".to_string()), ScalarDesc::Value(0.3)));
+    assert_eq!(mix("over"), (("worn".to_string(), "red".to_string()), ScalarDesc::Value(1.0)));
+    let ron = d.join("mix.ron");
+    let o = rust_v(&["convert", s(&p), "-o", s(&ron), "--strict"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&ron).unwrap();
+    assert!(text.contains("Mix(") && text.contains("materials: (\"red\", \"gold\")"), "{text}");
+    let a = film_of(&load_scene(&p, &small()).unwrap());
+    assert_same_films(&a, &film_of(&load_scene(&ron, &small()).unwrap()));
+    assert!(a.mean_xyz().iter().map(|p| p[1]).sum::<f64>() > 0.1, "something is lit");
+    for (line, what) in [
+        (
+            "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"red\" \"nope\"]\n",
+            "unknown material \"nope\"",
+        ),
+        (
+            "MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"red\" \"interface\"]\n",
+            "is an interface",
+        ),
+        ("MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"red\"]\n", "two material names"),
+    ] {
+        let setup = "MakeNamedMaterial \"red\" \"string type\" \"diffuse\"\nMakeNamedMaterial \"interface\" \"string type\" \"interface\"\n";
+        let p = write(&d, "bad.pbrt", &format!("{HEAD}{setup}{line}"));
+        let e = one_error(&rust_v(&["render", s(&p), "-o", s(&d.join("bad.png"))]));
+        assert!(e.contains("bad.pbrt:8:") && e.contains(what), "{e}");
+    }
+}

@@ -12,6 +12,9 @@
 //! which [`crate::scene::Scene::bsdf_in`] applies at each hit
 //! ([`Bxdf::with_reflectance`], [`Bxdf::set_roughness`], [`Bxdf::set_thickness_nm`]).
 //!
+//! A `Mix` is no lobe: [`mix`] builds it once every material is named, and
+//! the scene resolves it to one of its materials at each hit.
+//!
 //! Errors name the scene file and the field path
 //! (`materials."gold".roughness`) and what was expected.
 
@@ -23,6 +26,9 @@ use crate::error::Result;
 use crate::scene::check::Check;
 use crate::scene::desc::{CoatingDesc, IorDesc, MaterialDesc, ScalarDesc, SpectrumDesc};
 use crate::texture::{self, MaterialTextures};
+
+pub mod mix;
+pub use mix::Mix;
 
 /// The [`Bxdf`] of a material description at `field` (`materials."name"`), and
 /// its textures if it has any.
@@ -161,6 +167,8 @@ fn bxdf_of<'a>(
         }
         MaterialDesc::Black => Bxdf::Black,
         MaterialDesc::Interface => Bxdf::Interface,
+        // A placeholder: `mix::build` resolves the Mix once every material is named.
+        MaterialDesc::Mix { .. } => Bxdf::Black,
     })
 }
 

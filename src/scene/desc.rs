@@ -227,6 +227,11 @@ fn ones2() -> [f32; 2] {
     [1.0, 1.0]
 }
 
+/// A `Mix`'s default amount: each material half the time.
+fn half() -> ScalarDesc {
+    ScalarDesc::Value(0.5)
+}
+
 /// An index of refraction in the scene file.
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -330,6 +335,19 @@ pub enum MaterialDesc {
     },
     /// Absorbs everything.
     Black,
+    /// One of two other materials, chosen at each hit (pbrt-v4's `mix`):
+    /// `Mix(materials: ("paint", "metal"), amount: 0.3)` is the second with
+    /// probability `amount` (a number in [0, 1] or a texture of numbers), the
+    /// first otherwise; the choice is a hash of the hit point, so every
+    /// strategy sees the same one (`crate::material::mix`).
+    Mix {
+        /// The names of the two materials (either may be a Mix itself).
+        materials: (String, String),
+        /// The second material's share in [0, 1], or a texture of shares
+        /// (default ½, as pbrt's).
+        #[serde(default = "half")]
+        amount: ScalarDesc,
+    },
 }
 
 /// A scalar material parameter (`roughness`, `thickness_nm`): a number, as

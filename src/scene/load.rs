@@ -178,6 +178,7 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         materials.push(bxdf);
         textures.push(texture);
     }
+    let mixes = material::mix::build(ctx, &desc.materials.0, &by_name, &mut materials)?;
     // Media by name.
     let mut media = BTreeMap::new();
     for (name, m) in &desc.media.0 {
@@ -255,6 +256,12 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
                     let known: Vec<&str> = media.keys().copied().collect();
                     ctx.err(&field, format!("unknown medium \"{name}\"; defined: {}", known.join(", ")))
                 })?;
+                if mixes.get(material as usize).is_some_and(Option::is_some) {
+                    return Err(ctx.err(
+                        &field,
+                        "the material is a Mix (chosen per hit): an interior needs a Dielectric or an Interface",
+                    ));
+                }
                 let bxdf = &materials[material as usize];
                 if !bxdf.bounds_volume() {
                     return Err(ctx.err(
@@ -356,7 +363,9 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         }
         Some(lens) => lens_camera(ctx, c, lens, (eye, look_at, up), &settings)?,
     };
-    Ok(Scene::new(objects, materials, textures, lights, camera, settings, 0))
+    let mut scene = Scene::new(objects, materials, textures, lights, camera, settings, 0);
+    scene.mixes = mixes;
+    Ok(scene)
 }
 
 /// An object's `transform:` (`field`: `objects[i]`), checked: scale, rotation and

@@ -78,6 +78,9 @@ pub struct Scene {
     /// Each material's reflectance texture, if it has one (index for index
     /// with `materials`; empty when no material has one).
     textures: Vec<Option<MaterialTextures>>,
+    /// Each material's Mix, if it is one (index for index with `materials`,
+    /// where a Mix has a stand-in; empty when no material is a Mix).
+    mixes: Vec<Option<crate::material::Mix>>,
     /// Lights (area lights refer back to their object).
     pub lights: Vec<Light>,
     /// Probability of choosing each light for next-event estimation (∝ power).
@@ -213,6 +216,7 @@ impl Scene {
         let textures = if textures.iter().any(Option::is_some) { textures } else { Vec::new() };
         Scene {
             textures,
+            mixes: Vec::new(),
             environment,
             radius,
             dispersive,

@@ -9,7 +9,8 @@
 //! |---|---|
 //! | the closest surface along a ray | [`Scene::intersect`] (a [`SurfaceHit`]: point, normals, primitive, object) |
 //! | the surface coordinates of a hit, for a texture lookup | [`Scene::uv`] (on demand: nothing computes them during traversal) |
-//! | the BSDF at a surface | [`Scene::bsdf_in`] (textures evaluated at the hit); [`Scene::bsdf`] for what no texture changes |
+//! | the BSDF at a surface | [`Scene::bsdf_in`] (a `Mix` resolved and textures evaluated at the hit); [`Scene::bsdf`] for what neither changes |
+//! | which material a hit has (a `Mix` chooses per hit) | [`Scene::material_at`] |
 //! | emission leaving a surface hit | [`Scene::le`] (a textured emitter's radiance at the hit's (u, v)), and its light-sampling density for MIS, [`Scene::pdf_li`] |
 //! | a point on a light towards a shading point | [`Scene::sample_li`] (its radiance: [`crate::light::Light::with_radiance`] with the choice's `uv`) |
 //! | a ray leaving a light (BDPT, light tracing) | [`Scene::light`] then [`crate::light::Light::sample_le`] |
@@ -29,6 +30,7 @@ use crate::bxdf::{Bxdf, Outside};
 use crate::color::{Sampled, Spectrum};
 use crate::geometry::Ray;
 use crate::light::{Light, LightSample};
+use crate::material::mix;
 use crate::medium::{Crossing, Medium, Volume, VolumeStack};
 use crate::spectral::Lambdas;
 use crate::texture::{MaterialTextures, Texture};
@@ -73,7 +75,10 @@ impl Scene {
 
     /// The BSDF of object `object`'s material, untextured: for what does not
     /// depend on a texture (whether it is delta, black, dispersive; its
-    /// dielectric index); the lobe at a hit is [`Scene::bsdf_in`].
+    /// dielectric index); the lobe at a hit is [`Scene::bsdf_in`]. For a
+    /// `Mix`, the stand-in that answers for its object's volume (its
+    /// Dielectric, or black: [`crate::material::mix`]); what a hit on it is,
+    /// only [`Scene::material_at`] says.
     #[inline]
     pub fn bsdf(&self, object: u32) -> &Bxdf {
         &self.materials[self.objects[object as usize].material as usize]
@@ -83,9 +88,14 @@ impl Scene {
     /// reflectance evaluated at the hit's (u, v) and built in `slot`, which the
     /// caller keeps for the hit (a scene without textures pays one branch; a
     /// `Cow`, whose every use matches on it, cost 1.1% more instructions in a
-    /// Cornell-box render).
+    /// Cornell-box render). A `Mix` is resolved first ([`Scene::material_at`]);
+    /// a scene without one pays one more branch.
     #[inline(always)]
     pub fn bsdf_in<'a>(&'a self, si: &SurfaceHit, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
+        if !self.mixes.is_empty() {
+            let uv = if self.needs_uv(si.object) { self.uv(si) } else { Vec2::ZERO };
+            return self.mixed(si.object, si.hit.p, uv, slot);
+        }
         match self.texture(si.object) {
             Some(t) => slot.insert(self.textured(si.object, t, self.uv(si))),
             None => self.bsdf(si.object),
@@ -98,13 +108,56 @@ impl Scene {
         t.apply(self.bsdf(object), uv)
     }
 
-    /// The BSDF of object `object` at surface coordinates `uv` (as
-    /// [`Scene::bsdf_in`], for a path vertex that kept its (u, v)).
+    /// The BSDF of material `m` (a hit's, from [`Scene::material_at`]) at
+    /// surface coordinates `uv` (as [`Scene::bsdf_in`], for a path vertex
+    /// that resolved its material and kept its (u, v)).
     #[inline(always)]
-    pub fn bsdf_uv<'a>(&'a self, object: u32, uv: Vec2, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
-        match self.texture(object) {
-            Some(t) => slot.insert(self.textured(object, t, uv)),
-            None => self.bsdf(object),
+    pub fn bsdf_of<'a>(&'a self, m: u32, uv: Vec2, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
+        match self.material_texture(m) {
+            Some(t) => slot.insert(self.textured_material(m, t, uv)),
+            None => &self.materials[m as usize],
+        }
+    }
+
+    /// Material `m`'s lobe with textures `t` evaluated at `uv` (out of line).
+    #[inline(never)]
+    fn textured_material(&self, m: u32, t: &MaterialTextures, uv: Vec2) -> Bxdf {
+        t.apply(&self.materials[m as usize], uv)
+    }
+
+    /// The textures of material `m`, if it has any.
+    #[inline]
+    fn material_texture(&self, m: u32) -> Option<&MaterialTextures> {
+        if self.textures.is_empty() {
+            return None;
+        }
+        self.textures[m as usize].as_ref()
+    }
+
+    /// The material a hit on object `object` at point `p`, surface
+    /// coordinates `uv`, has: the object's, or where that is a `Mix`, the
+    /// material its per-hit choice leads to ([`crate::material::mix`]: a
+    /// function of the hit alone, so every strategy at one vertex sees the same).
+    #[inline]
+    pub fn material_at(&self, object: u32, p: Vec3, uv: Vec2) -> u32 {
+        let m = self.objects[object as usize].material;
+        if self.mixes.is_empty() { m } else { mix::choose(&self.mixes, m, object, p, uv) }
+    }
+
+    /// The BSDF at a hit on object `object` in a scene with a `Mix` (out of
+    /// line): the chosen material's, its textures evaluated at `uv`.
+    #[inline(never)]
+    fn mixed<'a>(&'a self, object: u32, p: Vec3, uv: Vec2, slot: &'a mut Option<Bxdf>) -> &'a Bxdf {
+        self.bsdf_of(self.material_at(object, p, uv), uv, slot)
+    }
+
+    /// The materials a hit with material `*m` may have: `m` itself, or a
+    /// Mix's leaves (for scene-level questions, which look through a Mix).
+    #[inline]
+    pub fn leaves<'a>(&'a self, m: &'a u32) -> &'a [u32] {
+        match self.mixes.get(*m as usize) {
+            Some(Some(mix)) => &mix.leaves,
+            _ => std::slice::from_ref(m),
         }
     }
 
@@ -176,8 +229,10 @@ impl Scene {
     /// ([`Scene::crossing`]), so light sampling reaches a delta light through it.
     pub fn has_delta_surface(&self) -> bool {
         self.objects.iter().any(|o| {
-            let m = &self.materials[o.material as usize];
-            m.is_delta() && !m.is_interface()
+            self.leaves(&o.material).iter().any(|&m| {
+                let m = &self.materials[m as usize];
+                m.is_delta() && !m.is_interface()
+            })
         })
     }
 
@@ -210,10 +265,12 @@ impl Scene {
     }
 
     /// True when something at a hit on object `object` depends on the hit's
-    /// (u, v): a textured material ([`Scene::texture`]) or a textured emission.
+    /// (u, v): a textured material ([`Scene::texture`]), a `Mix` (whose amount
+    /// or materials may be textured) or a textured emission.
     #[inline]
     pub fn needs_uv(&self, object: u32) -> bool {
         self.texture(object).is_some()
+            || self.mixes.get(self.objects[object as usize].material as usize).is_some_and(Option::is_some)
             || (self.emission_textures
                 && self.emitter(object).is_some_and(|l| self.lights[l as usize].emission_texture().is_some()))
     }

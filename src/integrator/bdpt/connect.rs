@@ -60,9 +60,9 @@ impl Bdpt {
                 }
                 if single { Contrib::Single(wl.at(&qs.beta, qs.collapsed) * e) } else { Contrib::Full(qs.beta * e) }
             }
-            Kind::Surface(o) => {
+            Kind::Surface(_) => {
                 let mut slot = None;
-                let bxdf = bsdf_at(scene, o, qs, &mut slot);
+                let bxdf = bsdf_at(scene, qs, &mut slot);
                 let wi = qs.sh.frame.to_local(w);
                 if !qs.sh.consistent(w, wi) {
                     return None;

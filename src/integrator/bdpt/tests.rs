@@ -61,8 +61,10 @@ fn walk(scene: &Scene, path: &mut Vec<Vertex>, mut pdf_dir: f32, points: &[Point
     for (i, q) in points.iter().enumerate() {
         let prev = *path.last().unwrap();
         let arrival = (q.p - prev.p()).normalize();
+        let kind = kind(q);
+        let material = if let Kind::Surface(o) = kind { scene.material_at(o, q.p, glam::Vec2::ZERO) } else { 0 };
         let mut v = Vertex {
-            kind: kind(q),
+            kind,
             sh: Shading::new(q.p, q.n, q.n, arrival),
             beta: Spectrum::ONE,
             delta: false,
@@ -72,6 +74,7 @@ fn walk(scene: &Scene, path: &mut Vec<Vertex>, mut pdf_dir: f32, points: &[Point
             g_prev: 0.0,
             outside: None,
             uv: glam::Vec2::ZERO,
+            material,
         };
         v.pdf_fwd = to_area(scene, pdf_dir, &prev, &v);
         v.g_prev = to_area(scene, 1.0, &v, &prev);

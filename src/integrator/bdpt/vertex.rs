@@ -51,8 +51,13 @@ pub(super) struct Vertex {
     /// At a dielectric's surface, the material of the medium on its outside
     /// (`None`: vacuum, or not a dielectric).
     pub(super) outside: Option<u32>,
-    /// The surface coordinates, where the material is textured (else zero).
+    /// The surface coordinates, where the material is textured or a `Mix`
+    /// (else zero).
     pub(super) uv: Vec2,
+    /// At a surface vertex, its material: the object's, or what a `Mix`
+    /// chose at this point ([`Scene::material_at`], resolved once when the
+    /// vertex is made, so every strategy sees the same); 0 elsewhere.
+    pub(super) material: u32,
 }
 
 impl Vertex {
@@ -70,6 +75,7 @@ impl Vertex {
             g_prev: 0.0,
             outside: None,
             uv: Vec2::ZERO,
+            material: 0,
         }
     }
 
@@ -160,18 +166,18 @@ pub(super) fn shading_correction(sh: &Shading, wi: Vec3, wi_local: Vec3) -> f32 
     if c.is_finite() { c } else { 0.0 }
 }
 
-/// The material of object `o`, untextured: for what no texture changes
-/// (delta, dispersive, black).
+/// The material of surface vertex `v`, untextured: for what no texture
+/// changes (delta, dispersive, black).
 #[inline]
-pub(super) fn material(scene: &Scene, o: u32) -> &Bxdf {
-    scene.bsdf(o)
+pub(super) fn material<'s>(scene: &'s Scene, v: &Vertex) -> &'s Bxdf {
+    &scene.materials[v.material as usize]
 }
 
-/// The BSDF at surface vertex `v` of object `o` (its texture evaluated at the
-/// vertex's (u, v), built in `slot`).
+/// The BSDF at surface vertex `v` (its material, a `Mix` already resolved,
+/// with its texture evaluated at the vertex's (u, v), built in `slot`).
 #[inline(always)]
-pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex, slot: &'s mut Option<Bxdf>) -> &'s Bxdf {
-    scene.bsdf_uv(o, v.uv, slot)
+pub(super) fn bsdf_at<'s>(scene: &'s Scene, v: &Vertex, slot: &'s mut Option<Bxdf>) -> &'s Bxdf {
+    scene.bsdf_of(v.material, v.uv, slot)
 }
 
 /// True when a connection can end at `v`: a surface whose material has a
@@ -181,7 +187,7 @@ pub(super) fn bsdf_at<'s>(scene: &'s Scene, o: u32, v: &Vertex, slot: &'s mut Op
 #[inline]
 pub(super) fn connectible(scene: &Scene, v: &Vertex) -> bool {
     match v.kind {
-        Kind::Surface(o) => !material(scene, o).is_delta(),
+        Kind::Surface(_) => !material(scene, v).is_delta(),
         Kind::Light(_) | Kind::Camera | Kind::Medium(_) => true,
     }
 }
@@ -190,7 +196,7 @@ pub(super) fn connectible(scene: &Scene, v: &Vertex) -> bool {
 /// medium outside it disperses).
 #[inline]
 pub(super) fn is_dispersive(scene: &Scene, v: &Vertex) -> bool {
-    matches!(v.kind, Kind::Surface(o) if material(scene, o).dispersion_within(outside(scene, v.outside)).is_some())
+    matches!(v.kind, Kind::Surface(_) if material(scene, v).dispersion_within(outside(scene, v.outside)).is_some())
 }
 
 /// The medium outside a dielectric vertex, from its material index.
@@ -224,9 +230,9 @@ pub(super) fn to_area(scene: &Scene, pdf_dir: f32, from: &Vertex, to: &Vertex) -
 #[inline]
 pub(super) fn pdf_at(scene: &Scene, v: &Vertex, wo: Vec3, wi: Vec3) -> f32 {
     match v.kind {
-        Kind::Surface(o) => {
+        Kind::Surface(_) => {
             let mut slot = None;
-            bsdf_at(scene, o, v, &mut slot).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside))
+            bsdf_at(scene, v, &mut slot).pdf_within(wo, wi, &Lambdas::full(), outside(scene, v.outside))
         }
         Kind::Medium(o) => scene.interior(o).map_or(0.0, |m| m.phase().eval(wo, wi)),
         _ => 0.0,
@@ -250,6 +256,7 @@ pub(super) fn medium_vertex(object: u32, p: Vec3, dir: Vec3, beta: Spectrum, col
         g_prev: 0.0,
         outside: None,
         uv: Vec2::ZERO,
+        material: 0,
     }
 }
 
@@ -286,7 +293,7 @@ impl Scatter<'_> {
 #[inline]
 pub(super) fn scatter<'s>(scene: &'s Scene, v: &Vertex, slot: &'s mut Option<Bxdf>) -> Option<Scatter<'s>> {
     match v.kind {
-        Kind::Surface(o) => Some(Scatter::Surface(bsdf_at(scene, o, v, slot), outside(scene, v.outside))),
+        Kind::Surface(_) => Some(Scatter::Surface(bsdf_at(scene, v, slot), outside(scene, v.outside))),
         Kind::Medium(o) => scene.interior(o).map(|m| Scatter::Medium(m.phase())),
         _ => None,
     }

@@ -66,7 +66,8 @@ impl Walk {
             let hit = si.hit;
             let uv = if scene.needs_uv(si.object) { scene.uv(&si) } else { glam::Vec2::ZERO };
             let mut slot = None;
-            let bxdf = scene.bsdf_uv(si.object, uv, &mut slot);
+            let material = scene.material_at(si.object, hit.p, uv);
+            let bxdf = scene.bsdf_of(material, uv, &mut slot);
             // The medium the segment ran in: Beer-Lambert where it only absorbs;
             // where it scatters (or is a grid), a distance by spectral MIS, and a
             // scattering event before the surface is a medium vertex.
@@ -169,6 +170,7 @@ impl Walk {
                 g_prev: 0.0,
                 outside: outside_material,
                 uv,
+                material,
             };
             v.pdf_fwd = if parallel { pdf_dir * ray.dir.dot(hit.n).abs() } else { to_area(scene, pdf_dir, prev, &v) };
             v.g_prev = to_area(scene, 1.0, &v, prev);

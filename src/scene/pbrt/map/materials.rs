@@ -160,7 +160,9 @@ impl Parser<'_> {
                 MaterialDesc::Lambertian { reflectance: scaled(r, s) }
             }
             "mix" => {
-                let amount = self.float_or_texture(ps, "amount", 0.5)?;
+                // pbrt chooses materials[1] where amount ≥ u (u a hash of the hit in
+                // [0, 1)), so an amount outside [0, 1] is the nearer end: clamped.
+                let amount = self.float_or_texture(ps, "amount", 0.5)?.clamp(0.0, 1.0) as f32;
                 let names = match self.param(ps, "materials") {
                     Some(Param { value: Value::Strs(s), .. }) if s.len() == 2 => s.clone(),
                     _ => {
@@ -169,19 +171,23 @@ impl Parser<'_> {
                         );
                     }
                 };
-                let pick = if amount >= 0.5 { &names[1] } else { &names[0] };
-                self.warn(at, format!("material \"mix\" is rendered as the material more likely chosen (\"{pick}\", amount {amount}), not a per-hit choice"))?;
-                self.check_used(ps, &what)?;
-                let m = self
-                    .built
-                    .named_materials
-                    .get(pick)
-                    .cloned()
-                    .ok_or_else(|| self.err(at, format!("material \"mix\": unknown material \"{pick}\"")))?;
-                if let Some(n) = name {
-                    self.built.named_materials.insert(n.to_string(), m.clone());
+                let mut children = Vec::with_capacity(2);
+                for n in &names {
+                    let child = match self.built.named_materials.get(n).cloned() {
+                        Some(MatRef::Name(c)) => c,
+                        Some(MatRef::Default) => self.default_material(),
+                        Some(MatRef::Interface) => {
+                            return Err(self.err(
+                                at,
+                                format!("material \"mix\": \"{n}\" is an interface (no surface); expected two surface materials"),
+                            ));
+                        }
+                        None => return Err(self.err(at, format!("material \"mix\": unknown material \"{n}\""))),
+                    };
+                    children.push(child);
                 }
-                return Ok(m);
+                let [a, b]: [String; 2] = children.try_into().expect("two names");
+                MaterialDesc::Mix { materials: (a, b), amount: crate::scene::desc::ScalarDesc::Value(amount) }
             }
             other => {
                 self.warn(at, format!("material \"{other}\" is not supported: rendered as diffuse 0.5"))?;
