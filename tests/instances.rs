@@ -68,7 +68,12 @@ fn bunny() -> String {
 
 /// The largest difference of the 8×8 block means of two renders.
 fn max_block_difference(a: &str, b: &str) -> (f64, f64) {
-    let (fa, fb) = (render_str(a, &SettingsPatch::default()), render_str(b, &SettingsPatch::default()));
+    max_block_difference_with(a, b, &SettingsPatch::default())
+}
+
+/// [`max_block_difference`] with `overrides` (an integrator, say) on both renders.
+fn max_block_difference_with(a: &str, b: &str, overrides: &SettingsPatch) -> (f64, f64) {
+    let (fa, fb) = (render_str(a, overrides), render_str(b, overrides));
     let (ma, mb) = (block_means(&fa, 8), block_means(&fb, 8));
     let diff = ma.iter().zip(&mb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
     (diff, ma.iter().sum::<f64>() / ma.len() as f64)
@@ -88,8 +93,10 @@ const HEAD: &str = r#"camera: (eye: (0, 1.2, 4), look_at: (0, 0.4, 0), fov_deg: 
 /// triangle edge: 8×8 block means agree within 0.1% of the image mean (measured: 3e-8
 /// relative), while moving one instance by 0.05 (a twentieth of its width) changes some
 /// block by 1.1% (measured), so the tolerance tells a misplaced instance from rounding.
-#[test]
-fn instances_render_like_copies() {
+/// Three instances of a group (the bunny and a box, each with its own material) on a
+/// floor, the second moved by `moved` in x; and the same meshes written out as objects
+/// placed by the same transforms (the copies).
+fn instances_and_copies(moved: f32) -> (String, String) {
     let (b, cube) = (bunny(), box_triangles([-0.1, 0.0, -0.1], [0.1, 0.2, 0.1], |p| p, false));
     let places = [
         "scale: 0.1, rotate_deg: (0, 30, 0), translate: (-0.8, 0, 0)",
@@ -97,7 +104,7 @@ fn instances_render_like_copies() {
         "scale: 0.07, translate: (0.9, 0.1, -0.5)",
     ];
     let floor = r#"(shape: Quad(origin: (-3, 0, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "white")"#;
-    let instanced = |moved: f32| {
+    let instanced = || {
         let objects: Vec<String> = places
             .iter()
             .enumerate()
@@ -130,13 +137,47 @@ fn instances_render_like_copies() {
         })
         .collect();
     let copies = format!(r#"({HEAD} objects: [ {floor}, {} ])"#, copies.join(", "));
-    let (diff, mean) = max_block_difference(&instanced(0.0), &copies);
+    (instanced(), copies)
+}
+
+#[test]
+fn instances_render_like_copies() {
+    let (instanced, copies) = instances_and_copies(0.0);
+    let (diff, mean) = max_block_difference(&instanced, &copies);
     println!("instances vs copies: largest block difference {diff:.2e}, image mean {mean:.4}");
     assert!(mean > 0.02, "something is lit: {mean}");
     assert!(diff < 1e-3 * mean, "block means differ by {diff} (image mean {mean})");
-    let (moved, _) = max_block_difference(&instanced(0.05), &copies);
+    let (moved, _) = max_block_difference(&instances_and_copies(0.05).0, &copies);
     println!("an instance moved by 0.05: largest block difference {moved:.2e}");
     assert!(moved > 5e-3 * mean, "the comparison does not see a moved instance: {moved}");
+}
+
+/// The failure matrix's row: every integrator and wavelength mode renders the instances
+/// of [`instances_render_like_copies`] like the copies, 8×8 block means within 0.1% of
+/// the image mean (the same samples on both sides; rounding alone differs, measured
+/// below 1e-6 relative with path). Light tracing and BDPT hit the instances from the
+/// lights' side too, and Whitted's delta paths through the point light check shadow
+/// rays against them.
+#[test]
+fn instances_render_like_copies_with_every_integrator() {
+    use rust_v::settings::{IntegratorKind, WavelengthsKind};
+    let (instanced, copies) = instances_and_copies(0.0);
+    let modes: [(IntegratorKind, Option<WavelengthsKind>); 7] = [
+        (IntegratorKind::Whitted, None),
+        (IntegratorKind::Path, None),
+        (IntegratorKind::Spectral, Some(WavelengthsKind::Hero)),
+        (IntegratorKind::Spectral, Some(WavelengthsKind::Random)),
+        (IntegratorKind::Auto, None),
+        (IntegratorKind::Bdpt, None),
+        (IntegratorKind::LightTrace, None),
+    ];
+    for (integrator, wavelengths) in modes {
+        let o = SettingsPatch { integrator: Some(integrator), wavelengths, ..SettingsPatch::default() };
+        let (diff, mean) = max_block_difference_with(&instanced, &copies, &o);
+        println!("{integrator:?} {wavelengths:?}: largest block difference {diff:.2e}, image mean {mean:.4}");
+        assert!(mean > 0.02, "{integrator:?}: something is lit: {mean}");
+        assert!(diff < 1e-3 * mean, "{integrator:?} {wavelengths:?}: block means differ by {diff} (image mean {mean})");
+    }
 }
 
 /// A glass wedge instanced through a mirroring matrix (determinant −1) refracts like
@@ -214,6 +255,11 @@ fn a_thousand_instances_keep_one_copy_of_the_triangles() {
 /// leaves is darkened to ¼ or less, so self-intersection shows as a centre block below ½.
 /// Tolerance: 5 standard errors of the block mean (its pixels' spread) plus 0.2%.
 fn furnace(groups: &str, object: &str, eye: [f32; 3]) -> (String, f64) {
+    furnace_with(groups, object, eye, &SettingsPatch::default())
+}
+
+/// [`furnace`] with `overrides` (another integrator).
+fn furnace_with(groups: &str, object: &str, eye: [f32; 3], overrides: &SettingsPatch) -> (String, f64) {
     let [x, y, z] = eye;
     let text = format!(
         r#"(camera: (eye: ({}, {}, {}), look_at: ({x}, {y}, {z}), fov_deg: 30),
@@ -226,7 +272,7 @@ fn furnace(groups: &str, object: &str, eye: [f32; 3]) -> (String, f64) {
         y + 0.2,
         z + 4.0
     );
-    let film = render_str(&text, &SettingsPatch::default());
+    let film = render_str(&text, overrides);
     let xyz = film.mean_xyz();
     let block: Vec<f64> = (5..11).flat_map(|y| (5..11).map(move |x| (x, y))).map(|(x, y)| xyz[y * 16 + x][1]).collect();
     let n = block.len() as f64;
@@ -261,6 +307,31 @@ fn an_instance_that_cancels_large_coordinates_does_not_self_intersect() {
     println!("far instance: centre Y {mean}");
     let scene = load_scene_str(&text, Path::new("test.ron"), &SettingsPatch::default()).unwrap();
     assert!(matches!(scene.objects[0].shape, Shape::Instance(_)));
+    // Light subpaths leave the far instance too (BDPT and light tracing), and the
+    // cancelling one (a copy) as well: the same ½ (the failure matrix's row).
+    use rust_v::settings::IntegratorKind;
+    for integrator in [IntegratorKind::Bdpt, IntegratorKind::LightTrace] {
+        // Light tracing's pixels are noisier (each light path reaches one pixel): 1024 spp.
+        let spp = if integrator == IntegratorKind::LightTrace { 1024 } else { 64 };
+        let o = SettingsPatch { integrator: Some(integrator), spp: Some(spp), ..SettingsPatch::default() };
+        for (name, shape, object, eye) in [
+            (
+                "near",
+                &near,
+                r#"(shape: Instance(group: "near"), transform: (matrix: ((0.8, -0.6, 0, 10000), (0.6, 0.8, 0, 10000), (0, 0, 1, 10000))))"#,
+                [10_000.0; 3],
+            ),
+            (
+                "far",
+                &far,
+                r#"(shape: Instance(group: "far"), transform: (translate: (10000, 10000, 10000)))"#,
+                [0.0; 3],
+            ),
+        ] {
+            let (_, mean) = furnace_with(&format!(r#""{name}": [ (shape: {shape}, material: "m") ]"#), object, eye, &o);
+            println!("{integrator:?}, {name}: centre Y {mean}");
+        }
+    }
 }
 
 /// Every mistake is one error line with the file, line:column and the field path.
