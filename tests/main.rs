@@ -11,6 +11,7 @@ mod camera;
 mod checkpoint;
 mod cli;
 mod docs;
+mod emitsample;
 mod environment;
 mod furnace;
 mod fuzz;

@@ -2,7 +2,10 @@
 //! triangle meshes, as a set of flat patches (parallelograms and triangles)
 //! sampled uniformly by area: a patch is chosen in proportion to its area,
 //! then a point uniformly on it, so the pdf per unit area is `1 / A` over
-//! the whole emitter and per solid angle `d² / (|cos θ_l| A)`.
+//! the whole emitter and per solid angle `d² / (|cos θ_l| A)`. A quad or
+//! cuboid whose emission is a texture is sampled by the texture's brightness
+//! instead (`super::texgrid`): the pdf per unit area is then `p_A(x)`, per
+//! solid angle `d² p_A(x) / |cos θ_l|`; a textured mesh stays uniform by area.
 //! A patch emits to the side its normal points to (a quad's
 //! `edge_u × edge_v`, a cuboid's outward faces, a triangle's
 //! counter-clockwise front) unless the object is `two_sided: true`.
@@ -19,6 +22,7 @@ use std::f32::consts::PI;
 
 use super::EmissionSample;
 use super::emit::{surface_pdf_dir, surface_ray};
+use super::texgrid::{Face, TextureGrid};
 use super::{EmissionTexture, LightSample, mean_radiance, sides};
 use crate::color::Spectrum;
 use crate::shape::{Cuboid, Mesh, Quad};
@@ -74,6 +78,9 @@ pub struct AreaLight {
     /// With a texture on a mesh, each patch's texture coordinates at its three
     /// corners (`p0`, `p0 + e1`, `p0 + e2`); else empty.
     uvs: Vec<[Vec2; 3]>,
+    /// With a texture on a quad or cuboid, the cells its points are drawn
+    /// from by brightness (else `None`: uniform by area).
+    grid: Option<Box<TextureGrid>>,
 }
 
 impl AreaLight {
@@ -94,7 +101,7 @@ impl AreaLight {
         for c in &mut cdf {
             *c /= area;
         }
-        Some(AreaLight { patches, cdf, area, radiance, two_sided, texture: None, uvs: Vec::new() })
+        Some(AreaLight { patches, cdf, area, radiance, two_sided, texture: None, uvs: Vec::new(), grid: None })
     }
 
     /// This light with its radiance given by `texture` at each point's (u, v)
@@ -115,6 +122,19 @@ impl AreaLight {
                 })
                 .collect();
         }
+        // A quad's or cuboid's (u, v) is each face's (a, b): its cells follow the texture.
+        let faces: Option<Vec<Face>> = self
+            .patches
+            .iter()
+            .map(|p| match *p {
+                Patch::Parallelogram { origin, u, v, n } => Some(Face { origin, u, v, n }),
+                Patch::Triangle { .. } => None,
+            })
+            .collect();
+        self.grid = match (&texture, faces) {
+            (Some(t), Some(faces)) if mesh.is_none() => TextureGrid::new(&faces, &t.texture).map(Box::new),
+            _ => None,
+        };
         self.texture = texture;
         self
     }
@@ -178,17 +198,31 @@ impl AreaLight {
         if self.two_sided { wi.dot(n).abs() } else { -wi.dot(n) }
     }
 
-    /// A point uniformly by area, its geometric normal, and its (u, v) when
-    /// the light has a texture (else zero).
+    /// A point (uniformly by area, or by a texture's brightness), its
+    /// geometric normal, its (u, v) when the light has a texture (else zero),
+    /// and its density per unit area.
     #[inline]
-    pub(super) fn sample_point(&self, u: Vec2) -> (Vec3, Vec3, Vec2) {
+    pub(super) fn sample_point(&self, u: Vec2) -> (Vec3, Vec3, Vec2, f32) {
+        if let Some(g) = &self.grid {
+            return g.sample(u);
+        }
         // Choose a patch with u.x, then reuse u.x's position within its interval.
         let k = self.cdf.partition_point(|&c| c <= u.x).min(self.patches.len() - 1);
         let lo = if k == 0 { 0.0 } else { self.cdf[k - 1] };
         let ux = ((u.x - lo) / (self.cdf[k] - lo)).clamp(0.0, 1.0 - f32::EPSILON);
         let (point, n, b) = self.patches[k].sample(Vec2::new(ux, u.y));
         let uv = if self.texture.is_some() { self.uv(k, b) } else { Vec2::ZERO };
-        (point, n, uv)
+        (point, n, uv, 1.0 / self.area)
+    }
+
+    /// The density per unit area with which [`Self::sample_point`] draws
+    /// `point`, a point of the light (`1 / A` unless a texture steers it).
+    #[inline]
+    pub fn pdf_area(&self, point: Vec3) -> f32 {
+        match &self.grid {
+            Some(g) => g.density(point),
+            None => 1.0 / self.area,
+        }
     }
 
     /// The total area of the emitting surface.
@@ -207,7 +241,7 @@ impl AreaLight {
     /// has a texture (else zero).
     #[inline]
     pub fn sample_li_uv(&self, p: Vec3, u: Vec2) -> Option<(LightSample, Vec2)> {
-        let (point, n, uv) = self.sample_point(u);
+        let (point, n, uv, pdf_area) = self.sample_point(u);
         let d = point - p;
         let d2 = d.length_squared();
         if d2 == 0.0 {
@@ -218,7 +252,8 @@ impl AreaLight {
         if cos_l <= 0.0 {
             return None;
         }
-        Some((LightSample { wi, point, n, pdf: d2 / (cos_l * self.area), scale: 1.0, is_delta: false }, uv))
+        let pdf = if self.grid.is_some() { d2 * pdf_area / cos_l } else { d2 / (cos_l * self.area) };
+        Some((LightSample { wi, point, n, pdf, scale: 1.0, is_delta: false }, uv))
     }
 
     /// The pdf per solid angle of [`AreaLight::sample_li`] from `p` for `wi`
@@ -229,23 +264,29 @@ impl AreaLight {
         if cos_l <= 0.0 {
             return 0.0;
         }
+        if self.grid.is_some() {
+            return (point - p).length_squared() * self.pdf_area(point) / cos_l;
+        }
         (point - p).length_squared() / (cos_l * self.area)
     }
 }
 
 /// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
 impl AreaLight {
-    /// A cosine-distributed ray from a point drawn uniformly by area.
+    /// A cosine-distributed ray from a point drawn as [`Self::sample_point`] draws it.
     #[inline]
     pub(super) fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
-        let (point, n, uv) = self.sample_point(u_pos);
-        surface_ray(point, n, uv, self.area(), self.two_sided, u_dir)
+        let (point, n, uv, pdf_area) = self.sample_point(u_pos);
+        let e = surface_ray(point, n, uv, self.area(), self.two_sided, u_dir)?;
+        Some(if self.grid.is_some() { EmissionSample { pdf_pos: pdf_area, ..e } } else { e })
     }
 
-    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`].
+    /// The densities `(pdf_pos, pdf_dir)` of [`Self::sample_le`] for a ray
+    /// leaving `point` (geometric normal `n`) along `dir`.
     #[inline]
-    pub(super) fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
-        (1.0 / self.area(), surface_pdf_dir(n, dir, self.two_sided))
+    pub(super) fn pdf_le(&self, point: Vec3, n: Vec3, dir: Vec3) -> (f32, f32) {
+        let pdf_pos = if self.grid.is_some() { self.pdf_area(point) } else { 1.0 / self.area() };
+        (pdf_pos, surface_pdf_dir(n, dir, self.two_sided))
     }
 }
 

@@ -103,13 +103,13 @@ impl Light {
     /// for delta lights, whose rays no other strategy can produce, the
     /// non-delta part only.
     #[inline]
-    pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+    pub fn pdf_le(&self, point: Vec3, n: Vec3, dir: Vec3) -> (f32, f32) {
         match self {
             Light::Point(l) => l.pdf_le(),
             Light::Spot(l) => l.pdf_le(dir),
             Light::Sphere(l) => l.pdf_le(n, dir),
             Light::Disk(l) => l.pdf_le(n, dir),
-            Light::Area(l) => l.pdf_le(n, dir),
+            Light::Area(l) => l.pdf_le(point, n, dir),
             Light::Distant(l) => l.pdf_le(),
             Light::Beam(l) => l.pdf_le(),
             Light::Environment(l) => l.pdf_le(dir),
@@ -213,7 +213,7 @@ mod tests {
                 let cos =
                     if light.is_delta_position() || light.is_delta_direction() { 1.0 } else { e.dir.dot(e.n).abs() };
                 sum += (e.scale * cos / (e.pdf_pos * e.pdf_dir)) as f64;
-                let (pp, pd) = light.pdf_le(e.n, e.dir);
+                let (pp, pd) = light.pdf_le(e.point, e.n, e.dir);
                 assert!((pp - e.pdf_pos).abs() <= 1e-5 * pp && (pd - e.pdf_dir).abs() <= 1e-4 * pd, "{light:?}");
             }
             let power = sum / n as f64;

@@ -32,6 +32,7 @@ mod point;
 pub mod sky;
 mod sphere;
 mod spot;
+mod texgrid;
 
 pub use area::AreaLight;
 pub use beam::BeamLight;

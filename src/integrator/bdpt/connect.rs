@@ -160,7 +160,7 @@ impl Bdpt {
                 } else {
                     scene.with_radiance(index, dir, pt.uv, |s| Contrib::Full(pt.beta * *s * le))
                 };
-                let (pdf_pos, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
+                let (pdf_pos, pdf_dir) = light.pdf_le(pt.p(), pt.sh.n, -dir);
                 let pt_rev = scene.light_pmf(index) * pdf_pos;
                 let as_light = Vertex { kind: Kind::Light(index), ..*pt };
                 let ptm_rev = to_area(scene, pdf_dir, &as_light, ptm);
@@ -208,7 +208,7 @@ impl Bdpt {
                 };
                 // The sampled light vertex, for the MIS weight (on the environment,
                 // a direction: its density is the direction's).
-                let (pdf_pos, pdf_dir) = light.pdf_le(ls.n, -ls.wi);
+                let (pdf_pos, pdf_dir) = light.pdf_le(ls.point, ls.n, -ls.wi);
                 let pdf_y = if light.is_infinite() { pmf * pdf_dir } else { pmf * pdf_pos };
                 let y = Vertex::at_point(Kind::Light(index), ls.point, ls.n, Spectrum::ONE, pdf_y);
                 let full = Lambdas::full();
@@ -296,7 +296,7 @@ impl Bdpt {
         if t == 2 {
             return c;
         }
-        let (_, pdf_dir) = light.pdf_le(pt.sh.n, -dir);
+        let (_, pdf_dir) = light.pdf_le(pt.p(), pt.sh.n, -dir);
         let pt_rev = scene.light_pmf(index) * pdf_dir;
         let ptm_rev = pdf_light(scene, pt, ptm);
         let overrides = Overrides { pt_rev, ptm_rev, qs_rev: 0.0, qsm_rev: 0.0 };

@@ -100,7 +100,7 @@ fn subpaths(scene: &Scene, path: &[Point]) -> (Vec<Vertex>, Vec<Vertex>) {
     let back: Vec<Point> = path.iter().rev().copied().collect();
     let (y0, rest) = back.split_first().unwrap();
     let l = scene.light(0);
-    let (pdf_pos, pdf_dir) = l.pdf_le(y0.n, (rest[0].p - y0.p).normalize());
+    let (pdf_pos, pdf_dir) = l.pdf_le(y0.p, y0.n, (rest[0].p - y0.p).normalize());
     let mut light = vec![Vertex::at_point(Kind::Light(0), y0.p, y0.n, Spectrum::ONE, scene.light_pmf(0) * pdf_pos)];
     walk(scene, &mut light, pdf_dir, rest, |q| Kind::Surface(q.object));
     (camera, light)
@@ -126,7 +126,7 @@ fn weight(scene: &Scene, camera: &[Vertex], light: &[Vertex], s: usize, t: usize
             let index = scene.emitter(LIGHT).unwrap();
             let l = scene.light(index);
             let dir = (pt.p() - ptm.p()).normalize();
-            let (pdf_pos, pdf_dir) = l.pdf_le(pt.sh.n, -dir);
+            let (pdf_pos, pdf_dir) = l.pdf_le(pt.p(), pt.sh.n, -dir);
             let as_light = Vertex { kind: Kind::Light(index), ..*pt };
             let o = Overrides {
                 pt_rev: scene.light_pmf(index) * pdf_pos,

@@ -329,7 +329,7 @@ pub(super) fn pdf_light(scene: &Scene, y: &Vertex, next: &Vertex) -> f32 {
     };
     let light = scene.light(i);
     let w = (next.p() - y.p()).normalize_or_zero();
-    let (pdf_pos, pdf_dir) = light.pdf_le(y.sh.n, w);
+    let (pdf_pos, pdf_dir) = light.pdf_le(y.p(), y.sh.n, w);
     if light.is_delta_direction() || light.is_infinite() {
         // Parallel rays: the disk's density projected onto `next`.
         let cos = if next.on_surface(scene) { w.dot(next.sh.n).abs() } else { 1.0 };
