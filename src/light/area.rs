@@ -215,8 +215,9 @@ impl AreaLight {
         (point, n, uv, 1.0 / self.area)
     }
 
-    /// The density per unit area with which [`Self::sample_point`] draws
-    /// `point`, a point of the light (`1 / A` unless a texture steers it).
+    /// The density per unit area with which the light draws `point`, a point
+    /// of its surface, for [`Self::sample_li`] and emitted rays (`1 / A`
+    /// unless a texture steers it).
     #[inline]
     pub fn pdf_area(&self, point: Vec3) -> f32 {
         match &self.grid {

@@ -62,7 +62,8 @@ pub struct EmissionTexture {
     pub texture: Texture,
     /// Its mean over the texture ([`Texture::mean_and_peak`]): the light's
     /// power for choosing among lights. Any positive power keeps the choice
-    /// unbiased; the points on the light are still drawn uniformly by area.
+    /// unbiased. On a quad or cuboid the points on the light are drawn by
+    /// the texture's brightness (`texgrid.rs`); elsewhere uniformly by area.
     pub mean: Spectrum,
 }
 
