@@ -93,7 +93,7 @@ fn corner(x: f64, y: f64, c: f64) -> f64 {
 
 /// Irradiance at `p` (normal +y) from the axis-aligned rectangle `[x0, x1] ×
 /// [z0, z1]` at height `h` facing down with radiance `l`.
-fn rectangle(p: Vec3, (x0, x1): (f64, f64), (z0, z1): (f64, f64), h: f64, l: f64) -> f64 {
+pub(crate) fn rectangle(p: Vec3, (x0, x1): (f64, f64), (z0, z1): (f64, f64), h: f64, l: f64) -> f64 {
     let (px, pz, c) = (p.x as f64, p.z as f64, h - p.y as f64);
     let g = |x: f64, z: f64| corner(x - px, z - pz, c);
     l / 2.0 * (g(x1, z1) - g(x0, z1) - g(x1, z0) + g(x0, z0))
