@@ -196,6 +196,9 @@ fn a_textured_cuboid_reports_the_density_it_samples() {
     assert!((got * area_total - 1.0).abs() < 1e-5, "one colour: {got} vs 1 / {area_total}");
 }
 
+/// A rectangle `[x0, x1] × [z0, z1]` of the emitter and its luminance.
+type Square = ((f64, f64), (f64, f64), f64);
+
 /// A mostly dark emitter lights a floor with the irradiance the closed form
 /// gives, through every method that draws points on it. The emitter: the
 /// unit square at height 1 facing down, a 16 x 16 grey EXR at 0.02 but for a
@@ -255,7 +258,7 @@ fn a_window_emitter_gives_the_closed_form_irradiance() {
             + fx * fy * at(x0 + 1.0, y0 + 1.0)
     };
     let m = 64;
-    let squares: Vec<((f64, f64), (f64, f64), f64)> = (0..m * m)
+    let squares: Vec<Square> = (0..m * m)
         .map(|k| {
             let (i, j) = ((k % m) as f64, (k / m) as f64);
             let h = 1.0 / m as f64;
