@@ -9,7 +9,11 @@
 //! over the whole emitter: no cell where the texture is non-zero has weight 0,
 //! so the estimate stays unbiased whatever the weights miss. A cell is chosen
 //! by its weight, then a point uniformly in it, so the density per unit area
-//! at a point of cell `c` is `w_c / (W · A_c)`, and [`TextureGrid::density`]
+//! at a point of cell `c` is `w_c / (W · A_c)` (exactly: the width of the
+//! cell's step of the f32 CDF over `A_c`, what the sampling does; a cell
+//! below ~6e-8 of the total, possible only with tens of thousands of cells of
+//! near-black texels, rounds to density 0, and MIS leaves its little light to
+//! the paths that hit it), and [`TextureGrid::density`]
 //! gives it back from the point alone (its face: the one whose plane it lies
 //! on; its cell: its (a, b) on that face), for `pdf_li` and `pdf_le`.
 //!
@@ -109,14 +113,21 @@ impl TextureGrid {
         let weights: Vec<f64> = raw.iter().map(|&(a, l)| a * (l + FLOOR * mean)).collect();
         let w_total: f64 = weights.iter().sum();
         let mut acc = 0.0f64;
-        let cdf = weights
+        let cdf: Vec<f32> = weights
             .iter()
             .map(|w| {
                 acc += w;
                 (acc / w_total) as f32
             })
             .collect();
-        let density = weights.iter().zip(&raw).map(|(w, c)| (w / (w_total * c.0)) as f32).collect();
+        // Each cell's probability as `sample` draws it: the width of its step
+        // of the f32 CDF (so sampling and density agree to the rounding).
+        let density = (0..cdf.len())
+            .map(|c| {
+                let lo = if c == 0 { 0.0 } else { cdf[c - 1] };
+                ((cdf[c] - lo) as f64 / raw[c].0) as f32
+            })
+            .collect();
         Some(TextureGrid { faces: grids, cdf, density })
     }
 
