@@ -17,23 +17,24 @@ pub fn read_mesh_file(path: &Path) -> Result<MeshData> {
 }
 
 /// Parses a mesh file's bytes (`path`'s name picks the format; errors name it).
-pub fn parse_mesh(raw: Vec<u8>, path: &Path) -> Result<MeshData> {
+pub fn parse_mesh(raw: impl AsRef<[u8]>, path: &Path) -> Result<MeshData> {
+    let raw = raw.as_ref();
     let name = path.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
     // A big gzip-compressed PLY: parsed while it inflates where it can (an ASCII body).
     if name.ends_with(".ply.gz")
         && raw.len() >= STREAM_GZ_BYTES
-        && let Some(d) = ply::parse_gz(&raw, path)
+        && let Some(d) = ply::parse_gz(raw, path)
     {
         return Ok(MeshData { positions: d.positions, triangles: d.triangles, normals: d.normals, uvs: d.uvs });
     }
     let (data, name) = if let Some(stem) = name.strip_suffix(".gz") {
         let mut out = Vec::with_capacity(raw.len() * 4);
-        flate2::read::MultiGzDecoder::new(raw.as_slice())
+        flate2::read::MultiGzDecoder::new(raw)
             .read_to_end(&mut out)
             .map_err(|e| Error::mesh(path, format!("gzip decompression failed: {e}")))?;
-        (out, stem.to_string())
+        (std::borrow::Cow::Owned(out), stem.to_string())
     } else {
-        (raw, name)
+        (std::borrow::Cow::Borrowed(raw), name)
     };
     if name.ends_with(".ply") {
         let d = ply::parse(&data, path)?;
