@@ -359,6 +359,7 @@ impl Mesh {
         let read = read_input(&path).map(|bytes| {
             // The file's hash (serial, about 1.5 ns a byte) beside the parse, not before it.
             let (data, hash) = rayon::join(|| parse_mesh(&bytes, &path), || fnv1a(&bytes));
+            drop(bytes);
             (hash, data.and_then(|data| Mesh::from_data_placed(data, &path, transform, then)))
         });
         MeshAhead { path, read }
