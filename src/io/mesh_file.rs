@@ -175,11 +175,11 @@ mod tests {
         }
         let bad = text.replacen("\n3 30000 30001 30002\n", "\n3 30000 x 30002\n", 1);
         assert_ne!(bad, text);
-        let want = parse_mesh(bad.clone().into_bytes(), plain).err().expect("an error").to_string();
+        let want = parse_mesh(bad.clone().into_bytes(), plain).expect_err("an error").to_string();
         let want = want.replace("big.ply:", "big.ply.gz:");
         assert!(want.contains("big.ply.gz: line "), "{want}");
         let line = want.split("line ").nth(1).unwrap().split(':').next().unwrap().to_string();
-        let got = parse_mesh(gzip(bad.as_bytes()), zipped).err().expect("an error").to_string();
+        let got = parse_mesh(gzip(bad.as_bytes()), zipped).expect_err("an error").to_string();
         assert_eq!(got, want);
         // The line number, counted independently: header 9 lines, 40000 vertices, 30000 faces before it.
         assert_eq!(line, (9 + 40_000 + 30_000 + 1).to_string());
