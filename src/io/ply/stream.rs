@@ -53,17 +53,25 @@ fn parse_gz_in(raw: &[u8], path: &Path, block: usize, chunk_lines: usize) -> Opt
     let a = Ascii { text: "", header_lines, elements: &elements, vi, fi, layout: &layout, path };
     let mut scan = Scan::new(&elements, header_lines, chunk_lines);
     let mut carry = head.split_off(body_start);
+    // `carry`'s first `no_newline` bytes have no line end.
+    let mut no_newline = 0;
     drop(head);
     let (tx, rx) = mpsc::channel::<(usize, Option<PlyData>)>();
     let complete = rayon::scope(|s| {
         loop {
             let n = inflate(&mut carry, block)?;
-            // The complete lines so far (at the end, all that is left).
-            let cut = if n == 0 { carry.len() } else { carry.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1) };
+            // The complete lines so far (at the end, all that is left). Only bytes not
+            // searched before are searched: a line of any length costs linear time.
+            let cut = match n {
+                0 => carry.len(),
+                _ => carry[no_newline..].iter().rposition(|&b| b == b'\n').map_or(0, |i| no_newline + i + 1),
+            };
             if cut == 0 && n > 0 {
+                no_newline = carry.len();
                 continue;
             }
             let rest = carry[cut..].to_vec();
+            no_newline = rest.len();
             carry.truncate(cut);
             let text = Arc::new(String::from_utf8(std::mem::replace(&mut carry, rest)).ok()?);
             for (k, chunk) in scan.chunks(&text, &elements) {
@@ -189,6 +197,13 @@ mod tests {
                     assert!(same(&serial, &got), "block {block}, chunk {chunk}");
                 }
             }
+        }
+        // A line longer than many blocks (a vertex line padded with 5000 spaces).
+        let padded = good.replacen("\n10 ", &format!("\n{}10 ", " ".repeat(5000)), 1);
+        assert_ne!(padded, good);
+        for block in [1, 7, 64] {
+            let got = parse_gz_in(&gzip(padded.as_bytes()), path, block, 3).expect("streamed");
+            assert!(same(&serial, &got), "padded, block {block}");
         }
         let bad_number = good.replacen("\n10 2 ", "\n10 x2 ", 1);
         let out_of_range = good.replacen("3 20 21 22", "3 20 21 99", 1);
