@@ -7,6 +7,9 @@ use crate::error::{Error, Result};
 use glam::Vec3;
 use std::path::Path;
 
+mod stream;
+pub(crate) use stream::parse_gz;
+
 /// What a PLY file yields: positions, triangles (vertex indices) and optional normals.
 pub(crate) struct PlyData {
     pub positions: Vec<Vec3>,
@@ -98,8 +101,35 @@ pub(crate) fn parse(data: &[u8], path: &Path) -> Result<PlyData> {
 /// [`parse`], an ASCII body in chunks of `chunk_lines` lines on the thread
 /// pool (`None`: line by line).
 fn parse_in(data: &[u8], path: &Path, chunk_lines: Option<usize>) -> Result<PlyData> {
-    let err = |msg: String| Error::mesh(path, msg);
     let (elements, format, body, header_lines) = parse_header(data, path)?;
+    let (vi, fi, layout) = layout_of(&elements, path)?;
+    let (ve, fe) = (&elements[vi], &elements[fi]);
+    // The header can claim any count: reserve no more than the body can hold (every
+    // element takes at least one byte), or a corrupt count aborts on allocation.
+    let (nv, nf) = (ve.count.min(body.len()), fe.count.min(body.len()));
+    let mut out = PlyData {
+        positions: Vec::with_capacity(nv),
+        triangles: Vec::with_capacity(nf * 2),
+        normals: layout.normal.map(|_| Vec::with_capacity(nv)),
+        uvs: layout.uv.map(|_| Vec::with_capacity(nv)),
+    };
+    match format {
+        Format::Ascii => {
+            let text =
+                std::str::from_utf8(body).map_err(|_| Error::mesh(path, "PLY body is not text (format says ascii)"))?;
+            let a = Ascii { text, header_lines, elements: &elements, vi, fi, layout: &layout, path };
+            if !chunk_lines.is_some_and(|n| a.read_chunked(&mut out, n)) {
+                a.read_serial(&mut out)?;
+            }
+        }
+        _ => read_binary(body, format, &elements, vi, fi, &layout, &mut out, path)?,
+    }
+    Ok(out)
+}
+
+/// Where the vertex and face elements are and where their data sits in them.
+fn layout_of(elements: &[Element], path: &Path) -> Result<(usize, usize, Layout)> {
+    let err = |msg: String| Error::mesh(path, msg);
     let vi = elements
         .iter()
         .position(|e| e.name == "vertex")
@@ -133,28 +163,7 @@ fn parse_in(data: &[u8], path: &Path, chunk_lines: Option<usize>) -> Result<PlyD
     {
         return Err(err("PLY face list must have integer count and index types".into()));
     }
-    let layout = Layout { xyz, normal, uv, face_list };
-    // The header can claim any count: reserve no more than the body can hold (every
-    // element takes at least one byte), or a corrupt count aborts on allocation.
-    let (nv, nf) = (ve.count.min(body.len()), fe.count.min(body.len()));
-    let mut out = PlyData {
-        positions: Vec::with_capacity(nv),
-        triangles: Vec::with_capacity(nf * 2),
-        normals: normal.map(|_| Vec::with_capacity(nv)),
-        uvs: uv.map(|_| Vec::with_capacity(nv)),
-    };
-    match format {
-        Format::Ascii => {
-            let text =
-                std::str::from_utf8(body).map_err(|_| Error::mesh(path, "PLY body is not text (format says ascii)"))?;
-            let a = Ascii { text, header_lines, elements: &elements, vi, fi, layout: &layout, path };
-            if !chunk_lines.is_some_and(|n| a.read_chunked(&mut out, n)) {
-                a.read_serial(&mut out)?;
-            }
-        }
-        _ => read_binary(body, format, &elements, vi, fi, &layout, &mut out, path)?,
-    }
-    Ok(out)
+    Ok((vi, fi, Layout { xyz, normal, uv, face_list }))
 }
 
 type Header<'a> = (Vec<Element>, Format, &'a [u8], usize);
@@ -315,20 +324,7 @@ impl Ascii<'_> {
             }
         }
         let parts: Vec<Option<PlyData>> = chunks.par_iter().map(|c| self.chunk(c).ok()).collect();
-        if parts.iter().any(Option::is_none) {
-            return false;
-        }
-        for part in parts.into_iter().flatten() {
-            out.positions.extend_from_slice(&part.positions);
-            out.triangles.extend_from_slice(&part.triangles);
-            if let (Some(o), Some(p)) = (out.normals.as_mut(), &part.normals) {
-                o.extend_from_slice(p);
-            }
-            if let (Some(o), Some(p)) = (out.uvs.as_mut(), &part.uvs) {
-                o.extend_from_slice(p);
-            }
-        }
-        true
+        append(out, parts)
     }
 
     /// One chunk's vertices or triangles.
@@ -402,6 +398,25 @@ impl Ascii<'_> {
         }
         Ok(())
     }
+}
+
+/// Appends the parts of a chunked parse to `out` in order; false, with `out`
+/// untouched, when any part failed.
+fn append(out: &mut PlyData, parts: Vec<Option<PlyData>>) -> bool {
+    if parts.iter().any(Option::is_none) {
+        return false;
+    }
+    for part in parts.into_iter().flatten() {
+        out.positions.extend_from_slice(&part.positions);
+        out.triangles.extend_from_slice(&part.triangles);
+        if let (Some(o), Some(p)) = (out.normals.as_mut(), &part.normals) {
+            o.extend_from_slice(p);
+        }
+        if let (Some(o), Some(p)) = (out.uvs.as_mut(), &part.uvs) {
+            o.extend_from_slice(p);
+        }
+    }
+    true
 }
 
 fn push_vertex(out: &mut PlyData, layout: &Layout, val: impl Fn(usize) -> f64) {
@@ -524,7 +539,7 @@ mod tests {
 
     /// An ASCII PLY with normals, uvs, an element between vertices and faces,
     /// quads, blank lines and CRLF line ends.
-    fn text(vertices: usize) -> String {
+    pub(super) fn text(vertices: usize) -> String {
         let mut t = format!(
             "ply\nformat ascii 1.0\nelement vertex {vertices}\nproperty float x\nproperty float y\nproperty float z\n\
              property float nx\nproperty float ny\nproperty float nz\nproperty float s\nproperty float t\n\
@@ -550,7 +565,7 @@ mod tests {
         t
     }
 
-    fn same(a: &PlyData, b: &PlyData) -> bool {
+    pub(super) fn same(a: &PlyData, b: &PlyData) -> bool {
         a.positions == b.positions && a.triangles == b.triangles && a.normals == b.normals && a.uvs == b.uvs
     }
 

@@ -357,8 +357,10 @@ impl Mesh {
     /// thread that made it.
     pub(crate) fn read_ahead(path: PathBuf, transform: &Transform, then: Option<&Then>) -> MeshAhead {
         let read = read_input(&path).map(|bytes| {
-            let hash = fnv1a(&bytes);
-            (hash, parse_mesh(bytes, &path).and_then(|data| Mesh::from_data_placed(data, &path, transform, then)))
+            // The file's hash (serial, about 1.5 ns a byte) beside the parse, not before it.
+            let (data, hash) = rayon::join(|| parse_mesh(&bytes, &path), || fnv1a(&bytes));
+            drop(bytes);
+            (hash, data.and_then(|data| Mesh::from_data_placed(data, &path, transform, then)))
         });
         MeshAhead { path, read }
     }
