@@ -102,3 +102,20 @@ pub fn block_means(film: &Film, b: usize) -> Vec<f64> {
     }
     out
 }
+
+/// For each pixel of an `n` x `n` render of `scene` (row by row), the checkerboard square
+/// `(⌊scale u⌋, ⌊scale v⌋)` of object 0 that the whole pixel lies within (all four corners'
+/// rays hit object 0 in that square), or `None` at a square's edge or off the object.
+pub fn pixel_squares(scene: &rust_v::scene::Scene, n: u32, scale: f32) -> Vec<Option<(i64, i64)>> {
+    let square = |x: u32, y: u32| {
+        let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(dx, dy)| {
+            let ray = scene.camera.ray(glam::Vec2::new(x as f32 + dx, y as f32 + dy));
+            let si = scene.intersect(&ray, f32::INFINITY).filter(|s| s.object == 0)?;
+            let uv = scene.uv(&si) * scale;
+            Some((uv.x.floor() as i64, uv.y.floor() as i64))
+        });
+        let first = corners[0]?;
+        corners.iter().all(|c| *c == Some(first)).then_some(first)
+    };
+    (0..n * n).map(|k| square(k % n, k / n)).collect()
+}

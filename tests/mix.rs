@@ -202,7 +202,6 @@ fn plane(materials: &str, material: &str) -> String {
 /// once, so a pixel depends only on what it sees). At least 40 pixels of each kind.
 #[test]
 fn a_checkerboard_amount_renders_each_square_like_its_material() {
-    use glam::Vec2;
     let children = r#""a": Lambertian(reflectance: Rgb(0.8, 0.3, 0.1)), "b": Conductor(metal: "Cu", roughness: 0.3)"#;
     let mixed = plane(
         &format!(r#"{children}, "m": Mix(materials: ("a", "b"), amount: Checkerboard(even: 0, odd: 1, scale: 2))"#),
@@ -211,23 +210,14 @@ fn a_checkerboard_amount_renders_each_square_like_its_material() {
     let n = 24;
     let o = settings(IntegratorKind::Path, n, 4);
     let scene = load_scene_str(&mixed, std::path::Path::new("plane.ron"), &o).unwrap();
-    let square = |x: u32, y: u32| {
-        let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(dx, dy)| {
-            let ray = scene.camera.ray(Vec2::new(x as f32 + dx, y as f32 + dy));
-            let si = scene.intersect(&ray, f32::INFINITY).filter(|s| s.object == 0)?;
-            let uv = scene.uv(&si) * 2.0;
-            Some((uv.x.floor() as i64, uv.y.floor() as i64))
-        });
-        let first = corners[0]?;
-        corners.iter().all(|c| *c == Some(first)).then_some(first)
-    };
+    let squares = crate::common::pixel_squares(&scene, n, 2.0);
     for method in [IntegratorKind::Path, IntegratorKind::Whitted, IntegratorKind::Auto, IntegratorKind::LightTrace] {
         let o = settings(method, n, 4);
         let got = render_str(&mixed, &o).mean_xyz();
         let want = [render_str(&plane(children, "a"), &o).mean_xyz(), render_str(&plane(children, "b"), &o).mean_xyz()];
         let mut counts = [0; 2];
-        for k in 0..(n * n) as usize {
-            let Some((i, j)) = square(k as u32 % n, k as u32 / n) else { continue };
+        for (k, sq) in squares.iter().enumerate() {
+            let Some((i, j)) = *sq else { continue };
             let odd = usize::from((i + j).rem_euclid(2) == 1);
             assert_eq!(got[k], want[odd][k], "{method:?}: pixel {k} in square ({i}, {j})");
             counts[odd] += 1;

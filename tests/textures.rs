@@ -260,17 +260,7 @@ fn a_scalar_checkerboard_renders_each_square_like_its_constant() {
         let o = settings(IntegratorKind::Path, n, 4);
         let scene = load_scene_str(&textured, std::path::Path::new("plane.ron"), &o).unwrap();
         // The square (i, j) each pixel lies within, if one.
-        let square = |x: u32, y: u32| {
-            let corners = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].map(|(dx, dy)| {
-                let ray = scene.camera.ray(Vec2::new(x as f32 + dx, y as f32 + dy));
-                let si = scene.intersect(&ray, f32::INFINITY).filter(|s| s.object == 0)?;
-                let uv = scene.uv(&si) * 2.0;
-                Some((uv.x.floor() as i64, uv.y.floor() as i64))
-            });
-            let first = corners[0]?;
-            corners.iter().all(|c| *c == Some(first)).then_some(first)
-        };
-        let squares: Vec<Option<(i64, i64)>> = (0..n * n).map(|k| square(k % n, k / n)).collect();
+        let squares = crate::common::pixel_squares(&scene, n, 2.0);
         for (method, wavelengths) in methods {
             let o = SettingsPatch { wavelengths, ..settings(method, n, 4) };
             let got = render_str(&textured, &o).mean_xyz();

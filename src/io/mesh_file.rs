@@ -122,7 +122,7 @@ fn load_obj(data: &[u8], path: &Path) -> Result<MeshData> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::io::Write;
+    use crate::io::gzip;
 
     /// An ASCII PLY of `n` vertices in a strip of `n - 2` triangles.
     fn strip(n: usize) -> String {
@@ -139,12 +139,6 @@ mod tests {
             t += &format!("3 {} {} {}\n", i, i + 1, i + 2);
         }
         t
-    }
-
-    fn gzip(data: &[u8]) -> Vec<u8> {
-        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-        e.write_all(data).unwrap();
-        e.finish().unwrap()
     }
 
     /// A gzip file big enough to be parsed while it inflates gives the data of

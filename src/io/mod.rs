@@ -19,6 +19,15 @@ pub use atomic_file::{NAME_MAX, temp_path, write_atomic};
 pub use files::{check_aliasing, check_output, check_regular, is_snapshot_name, parent_dir, read_input};
 pub use hash::{Fnv1a, fnv1a};
 pub use mesh_file::{MeshData, parse_mesh, read_mesh_file};
+
+/// `data` gzip-compressed (for tests of the readers of `.gz` files).
+#[cfg(test)]
+pub(crate) fn gzip(data: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    e.write_all(data).unwrap();
+    e.finish().unwrap()
+}
 pub use spectrum_file::{
     SpectrumFileError, SpectrumRow, TableRow, parse_spectrum_file, parse_spectrum_rows, parse_table,
 };

@@ -387,6 +387,27 @@ fn ratios<const N: usize>(sigma_t: &Sampled<N>, j: usize, collisions: u32, walke
 mod tests {
     use super::*;
 
+    /// Per bin, the mean of `runs` ratio-tracking estimates of the transmittance
+    /// from `from` to `to` (`exp(−τ)` of [`Medium::optical_depth`], run `k` its
+    /// own random sequence) and its standard error.
+    fn mean_transmittance(m: &Medium, from: Vec3, to: Vec3, runs: u64) -> Vec<(f64, f64)> {
+        let (mut sum, mut sum2) = (vec![0.0f64; N_BINS], vec![0.0f64; N_BINS]);
+        for k in 0..runs {
+            let tau = m.optical_depth(from, to, k);
+            for b in 0..N_BINS {
+                let t = (-tau[b] as f64).exp();
+                sum[b] += t;
+                sum2[b] += t * t;
+            }
+        }
+        (0..N_BINS)
+            .map(|b| {
+                let mean = sum[b] / runs as f64;
+                (mean, ((sum2[b] / runs as f64 - mean * mean).max(0.0) / runs as f64).sqrt())
+            })
+            .collect()
+    }
+
     /// Ratio tracking through a grid whose density is a linear ramp along x
     /// (64 voxels, value (i + ½)/64: the trilinear density is x itself between
     /// the first and last voxel centres, flat beyond) is unbiased against the
@@ -406,20 +427,8 @@ mod tests {
         let (c0, c1) = (0.5 / n as f64, 1.0 - 0.5 / n as f64);
         let unit = (c1 * c1 - c0 * c0) / 2.0 + c0 * c0 + (1.0 - c1) * c1;
         let (from, to) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0));
-        let runs = 4000;
-        let mut sum = vec![0.0f64; N_BINS];
-        let mut sum2 = vec![0.0f64; N_BINS];
-        for k in 0..runs {
-            let tau = m.optical_depth(from, to, k);
-            for b in 0..N_BINS {
-                let t = (-tau[b] as f64).exp();
-                sum[b] += t;
-                sum2[b] += t * t;
-            }
-        }
-        for b in 0..N_BINS {
-            let mean = sum[b] / runs as f64;
-            let se = ((sum2[b] / runs as f64 - mean * mean).max(0.0) / runs as f64).sqrt();
+        let t = mean_transmittance(&m, from, to, 4000);
+        for (b, &(mean, se)) in t.iter().enumerate() {
             let want = (-(0.1 + 0.3 + 0.1 * b as f64) * 2.0 * unit).exp();
             assert!((mean - want).abs() < 5.0 * se + 1e-4, "bin {b}: T = {mean} ± {se}, want {want}");
         }
@@ -478,19 +487,9 @@ mod tests {
         for (from, to) in rays {
             let tau = quadrature(&m, from, to);
             assert!(tau > 0.05, "the ray crosses the blob: {tau}");
-            let runs = 3000;
-            let (mut sum, mut sum2) = (vec![0.0f64; N_BINS], vec![0.0f64; N_BINS]);
-            for k in 0..runs {
-                let od = m.optical_depth(from, to, k);
-                for b in 0..N_BINS {
-                    let t = (-od[b] as f64).exp();
-                    sum[b] += t;
-                    sum2[b] += t * t;
-                }
-            }
+            let t = mean_transmittance(&m, from, to, 3000);
             for b in (0..N_BINS).step_by(5) {
-                let mean = sum[b] / runs as f64;
-                let se = ((sum2[b] / runs as f64 - mean * mean).max(0.0) / runs as f64).sqrt();
+                let (mean, se) = t[b];
                 let want = (-(m.sigma_t[b] as f64) * tau).exp();
                 assert!(
                     (mean - want).abs() < 5.0 * se + 1e-4,

@@ -435,7 +435,6 @@ mod tests {
     use crate::shape::Triangle;
     use crate::shape::sphere::tests::{random_dir, uniform};
     use rand_pcg::Pcg32;
-    use std::io::Write;
     use std::path::PathBuf;
 
     fn temp(name: &str) -> PathBuf {
@@ -507,9 +506,7 @@ mod tests {
         let b = temp("quad_bin.ply");
         std::fs::write(&b, binary_ply()).unwrap();
         let g = temp("quad.ply.gz");
-        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-        enc.write_all(ascii_ply("1 4 0 1 2 3\n0 3 0 1 4\n", 2).as_bytes()).unwrap();
-        std::fs::write(&g, enc.finish().unwrap()).unwrap();
+        std::fs::write(&g, crate::io::gzip(ascii_ply("1 4 0 1 2 3\n0 3 0 1 4\n", 2).as_bytes())).unwrap();
         let (ma, mb, mg) = (Mesh::load(&a, &t).unwrap(), Mesh::load(&b, &t).unwrap(), Mesh::load(&g, &t).unwrap());
         assert_eq!(ma.triangle_count(), 3, "quad fan-triangulated + triangle");
         let v = VERTS.map(Vec3::from);

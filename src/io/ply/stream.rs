@@ -167,13 +167,7 @@ impl Scan {
 mod tests {
     use super::super::tests::{same, text};
     use super::*;
-    use std::io::Write;
-
-    fn gzip(data: &[u8]) -> Vec<u8> {
-        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
-        e.write_all(data).unwrap();
-        e.finish().unwrap()
-    }
+    use crate::io::gzip;
 
     /// Parsed while inflating, the data is the serial reader's of the inflated
     /// file bit for bit, for blocks from 1 byte (a block boundary in every line
