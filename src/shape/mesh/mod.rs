@@ -10,6 +10,7 @@ use crate::scene::desc::{ScaleDesc, V3};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Vec3};
+use rayon::prelude::*;
 
 use super::bvh::{MAX_BLOCKS, TriangleHit, WideBvh};
 use crate::error::{Error, Result};
@@ -155,45 +156,19 @@ impl Mesh {
         // The file's positions stay until the triangles are checked: a transform that
         // collapses them (in f32) is told apart from a mesh that was degenerate already.
         let original = positions;
-        let mut positions = Vec::with_capacity(original.len());
-        for (i, p) in original.iter().enumerate() {
-            if !p.is_finite() {
-                return Err(err(format!("vertex {i} has a non-finite coordinate {p}")));
-            }
-            let q = m * *p + translate;
-            if !q.is_finite() {
-                return Err(setting(
-                    "scale",
-                    format!("vertex {i} leaves f32's range after the transform: the scale or translation is too large"),
-                ));
-            }
-            positions.push(q);
-        }
+        let positions = place_vertices(&original, m, translate, err)?;
         if let Some(ns) = normals.as_mut() {
             let nm = m.inverse().transpose();
-            for n in ns.iter_mut() {
-                // Zero or broken normals become zero and fall back to the geometric normal.
-                *n = (nm * *n).normalize_or_zero();
+            // Zero or broken normals become zero and fall back to the geometric normal.
+            let turn = |n: &mut Vec3| *n = (nm * *n).normalize_or_zero();
+            if ns.len() > PARALLEL_PLACE {
+                ns.par_chunks_mut(PLACE_CHUNK).for_each(|c| c.iter_mut().for_each(turn));
+            } else {
+                ns.iter_mut().for_each(turn);
             }
         }
         // A mirroring transform flips the winding; swap two vertices to keep the front.
-        let mirror = det < 0.0;
-        let nv = positions.len();
-        let mut kept: Vec<[u32; 3]> = Vec::with_capacity(indices.len());
-        let mut dropped = Vec::new();
-        for (f, tri) in indices.iter().enumerate() {
-            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
-                return Err(err(format!("triangle {f}: vertex index {bad} out of range (there are {nv} vertices)")));
-            }
-            let tri = if mirror { [tri[0], tri[2], tri[1]] } else { *tri };
-            let [a, b, c] = tri.map(|i| positions[i as usize]);
-            let area2 = (b - a).cross(c - a).length_squared();
-            if area2 > 0.0 && area2.is_finite() {
-                kept.push(tri);
-            } else {
-                dropped.push(f as u32);
-            }
-        }
+        let (kept, dropped) = keep_triangles(&positions, &indices, det < 0.0, err)?;
         if kept.is_empty() {
             let has_area = |p: &dyn Fn(u32) -> Vec3| {
                 indices
@@ -429,262 +404,136 @@ impl Mesh {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::shape::Triangle;
-    use crate::shape::sphere::tests::{random_dir, uniform};
-    use rand_pcg::Pcg32;
-    use std::path::PathBuf;
+/// Meshes with more vertices or triangles than this are placed and checked in
+/// parallel, over fixed chunks of [`PLACE_CHUNK`] joined in order: the same arrays,
+/// and the same first error, as one pass in order.
+const PARALLEL_PLACE: usize = 1 << 16;
+/// Vertices or triangles per chunk of the parallel placing.
+const PLACE_CHUNK: usize = 1 << 15;
 
-    fn temp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("rust-v-mesh-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
+/// The first problem a chunk of the placing found (made an [`Error`] outside the pool).
+enum Bad {
+    /// Vertex `i` is not finite in the file.
+    Vertex(usize, Vec3),
+    /// Vertex `i` is not finite after the transform.
+    Placed(usize),
+    /// Triangle `f` names vertex `bad`, out of range of the `nv` vertices.
+    Index(usize, u32, usize),
+}
+
+/// Runs `one(first index, chunk, out)` over `items` in order: in parallel over fixed
+/// chunks joined in order when there are many, so the output and the first problem
+/// are those of one pass.
+fn in_chunks<T: Sync, O: Send + Default>(
+    items: &[T],
+    one: impl Fn(usize, &[T], &mut O) -> std::result::Result<(), Bad> + Sync,
+    join: impl Fn(&mut O, O),
+) -> std::result::Result<O, Bad> {
+    let mut out = O::default();
+    if items.len() <= PARALLEL_PLACE {
+        one(0, items, &mut out)?;
+        return Ok(out);
     }
-
-    /// Triangles in file order, as vertex positions.
-    fn tris_in_file_order(m: &Mesh) -> Vec<[Vec3; 3]> {
-        let mut v: Vec<(u32, [Vec3; 3])> =
-            (0..m.triangle_count() as u32).map(|k| (m.original_index(k), m.triangle(k))).collect();
-        v.sort_by_key(|x| x.0);
-        v.into_iter().map(|x| x.1).collect()
+    let parts: Vec<std::result::Result<O, Bad>> = items
+        .par_chunks(PLACE_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut o = O::default();
+            one(c * PLACE_CHUNK, chunk, &mut o).map(|_| o)
+        })
+        .collect();
+    for part in parts {
+        join(&mut out, part?);
     }
+    Ok(out)
+}
 
-    const VERTS: [[f32; 3]; 5] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [0.5, 0.5, 1.0]];
-
-    fn ascii_ply(faces: &str, n_faces: usize) -> String {
-        let mut s = String::from(
-            "ply\nformat ascii 1.0\ncomment test\nelement vertex 5\nproperty float x\nproperty float y\n\
-             property float z\nproperty float confidence\nelement edge 1\nproperty int vertex1\nproperty int vertex2\n",
-        );
-        s += &format!(
-            "element face {n_faces}\nproperty uchar flags\nproperty list uchar int vertex_indices\nend_header\n"
-        );
-        for (i, v) in VERTS.iter().enumerate() {
-            s += &format!("{} {} {} {}\n", v[0], v[1], v[2], i as f32 * 0.5);
-        }
-        s += "0 1\n";
-        s += faces;
-        s
-    }
-
-    fn binary_ply() -> Vec<u8> {
-        let mut b = Vec::new();
-        b.extend_from_slice(
-            b"ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty double x\nproperty double y\n\
-              property double z\nproperty list uchar float junk\nproperty float confidence\nelement edge 1\n\
-              property int vertex1\nproperty int vertex2\nelement face 2\nproperty uchar flags\n\
-              property list uchar uint vertex_index\nend_header\n",
-        );
-        for v in VERTS {
-            for c in v {
-                b.extend_from_slice(&(c as f64).to_le_bytes());
-            }
-            b.push(2);
-            b.extend_from_slice(&1.0f32.to_le_bytes());
-            b.extend_from_slice(&2.0f32.to_le_bytes());
-            b.extend_from_slice(&0.5f32.to_le_bytes());
-        }
-        b.extend_from_slice(&0i32.to_le_bytes());
-        b.extend_from_slice(&1i32.to_le_bytes());
-        for face in [&[0u32, 1, 2, 3][..], &[0, 1, 4]] {
-            b.push(7);
-            b.push(face.len() as u8);
-            for i in face {
-                b.extend_from_slice(&i.to_le_bytes());
-            }
-        }
-        b
-    }
-
-    #[test]
-    fn ply_ascii_binary_and_gz_agree() {
-        let t = Transform::default();
-        let a = temp("quad.ply");
-        std::fs::write(&a, ascii_ply("1 4 0 1 2 3\n\n0 3 0 1 4\n", 2)).unwrap();
-        let b = temp("quad_bin.ply");
-        std::fs::write(&b, binary_ply()).unwrap();
-        let g = temp("quad.ply.gz");
-        std::fs::write(&g, crate::io::gzip(ascii_ply("1 4 0 1 2 3\n0 3 0 1 4\n", 2).as_bytes())).unwrap();
-        let (ma, mb, mg) = (Mesh::load(&a, &t).unwrap(), Mesh::load(&b, &t).unwrap(), Mesh::load(&g, &t).unwrap());
-        assert_eq!(ma.triangle_count(), 3, "quad fan-triangulated + triangle");
-        let v = VERTS.map(Vec3::from);
-        let expect = vec![[v[0], v[1], v[2]], [v[0], v[2], v[3]], [v[0], v[1], v[4]]];
-        assert_eq!(tris_in_file_order(&ma), expect);
-        assert_eq!(tris_in_file_order(&mb), expect);
-        assert_eq!(tris_in_file_order(&mg), expect);
-        assert!(!ma.has_normals());
-        let h = ma.intersect(&Ray::new(Vec3::new(0.2, 0.7, 5.0), -Vec3::Z), f32::INFINITY).unwrap();
-        assert!((h.t - 5.0).abs() < 1e-6 && h.n == Vec3::Z && h.ns == h.n);
-    }
-
-    #[test]
-    fn ply_errors_name_file_and_line() {
-        let t = Transform::default();
-        let p = temp("truncated.ply");
-        std::fs::write(&p, ascii_ply("1 4 0 1 2 3\n", 2)).unwrap();
-        let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(e.contains("truncated.ply") && e.contains("line 23") && e.contains("end of file"), "{e}");
-        let p = temp("range.ply");
-        std::fs::write(&p, ascii_ply("1 4 0 1 2 3\n0 3 0 1 5\n", 2)).unwrap();
-        let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(e.contains("range.ply") && e.contains("line 23") && e.contains("out of range"), "{e}");
-        let p = temp("short.ply");
-        std::fs::write(&p, ascii_ply("1 4 0 1 2 3\n0 3 0 1\n", 2)).unwrap();
-        let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(e.contains("short.ply") && e.contains("line 23") && e.contains("end of line"), "{e}");
-        let p = temp("trunc_bin.ply");
-        let b = binary_ply();
-        std::fs::write(&p, &b[..b.len() - 3]).unwrap();
-        let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(e.contains("trunc_bin.ply") && e.contains("face") && e.contains("end of file"), "{e}");
-        let p = temp("bad.ply.gz");
-        std::fs::write(&p, b"not gzip").unwrap();
-        assert!(Mesh::load(&p, &t).unwrap_err().to_string().contains("bad.ply.gz"));
-        let e = Mesh::load(&temp("missing.obj"), &t).unwrap_err().to_string();
-        assert!(e.contains("missing.obj"), "{e}");
-        let p = temp("degenerate.ply");
-        std::fs::write(&p, ascii_ply("1 3 0 1 1\n", 1)).unwrap();
-        let e = Mesh::load(&p, &t).unwrap_err().to_string();
-        assert!(e.contains("no valid triangles"), "{e}");
-    }
-
-    fn brute(m: &Mesh, ray: &Ray, t_max: f32) -> Option<(f32, u32)> {
-        (0..m.triangle_count() as u32)
-            .filter_map(|k| {
-                let [a, b, c] = m.triangle(k);
-                Triangle::new(a, b, c).intersect(ray, t_max).map(|h| (h.t, k))
-            })
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-    }
-
-    /// BVH traversal agrees with brute force on random rays through the mesh's bounds.
-    fn check_against_brute_force(m: &Mesh, n_rays: usize, seed: u64) {
-        let b = m.bounds();
-        let mut rng = Pcg32::new(seed, 4);
-        let point = |rng: &mut Pcg32| {
-            b.min + b.diagonal() * Vec3::new(uniform(rng), uniform(rng), uniform(rng)) * 1.4 - b.diagonal() * 0.2
-        };
-        let mut hits = 0;
-        for i in 0..n_rays {
-            let o = point(&mut rng);
-            let d = if i % 2 == 0 { random_dir(&mut rng) } else { (point(&mut rng) - o).normalize() };
-            let ray = Ray::new(o, d);
-            let expect = brute(m, &ray, f32::INFINITY);
-            let got = m.intersect(&ray, f32::INFINITY);
-            match (expect, got) {
-                (None, None) => {}
-                (Some((t, k)), Some(h)) => {
-                    hits += 1;
-                    assert!((t - h.t).abs() <= 1e-5 * t, "ray {i}: t {t} vs {}", h.t);
-                    // Different triangles only for a tie (a ray through a shared edge or vertex).
-                    assert!(k == h.prim || (t - h.t).abs() <= 1e-6 * t, "ray {i}: triangle {k} vs {}", h.prim);
-                    assert!((h.n.length() - 1.0).abs() < 1e-5 && h.ns.dot(h.n) >= 0.0);
+/// The vertices `original` under `m · p + translate`; the first vertex (in order) that
+/// is not finite before or after is the error.
+fn place_vertices(original: &[Vec3], m: Mat3, translate: Vec3, err: &dyn Fn(String) -> Error) -> Result<Vec<Vec3>> {
+    let placed = in_chunks(
+        original,
+        |base, ps, out: &mut Vec<Vec3>| {
+            out.reserve_exact(ps.len());
+            for (k, p) in ps.iter().enumerate() {
+                if !p.is_finite() {
+                    return Err(Bad::Vertex(base + k, *p));
                 }
-                (e, g) => panic!("ray {i}: brute force {e:?} vs bvh {:?}", g.map(|h| (h.t, h.prim))),
+                let q = m * *p + translate;
+                if !q.is_finite() {
+                    return Err(Bad::Placed(base + k));
+                }
+                out.push(q);
             }
-            assert_eq!(m.occluded(&ray, f32::INFINITY), expect.is_some(), "ray {i}: occluded");
+            Ok(())
+        },
+        |out, part| {
+            if out.is_empty() {
+                out.reserve_exact(original.len());
+            }
+            out.extend_from_slice(&part)
+        },
+    );
+    placed.map_err(|bad| bad.error(err))
+}
+
+/// The triangles of `indices` with an area (in `positions`), two vertices swapped
+/// when `mirror`, and the file-order indices of those without; an index out of range
+/// is an error (the first, in order).
+fn keep_triangles(
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    mirror: bool,
+    err: &dyn Fn(String) -> Error,
+) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
+    let nv = positions.len();
+    let kept = in_chunks(
+        indices,
+        |base, tris, (kept, dropped): &mut (Vec<[u32; 3]>, Vec<u32>)| {
+            kept.reserve_exact(tris.len());
+            for (k, tri) in tris.iter().enumerate() {
+                if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
+                    return Err(Bad::Index(base + k, bad, nv));
+                }
+                let tri = if mirror { [tri[0], tri[2], tri[1]] } else { *tri };
+                let [a, b, c] = tri.map(|i| positions[i as usize]);
+                let area2 = (b - a).cross(c - a).length_squared();
+                if area2 > 0.0 && area2.is_finite() {
+                    kept.push(tri);
+                } else {
+                    dropped.push((base + k) as u32);
+                }
+            }
+            Ok(())
+        },
+        |(kept, dropped), (k, d)| {
+            if kept.is_empty() {
+                kept.reserve_exact(indices.len());
+            }
+            kept.extend_from_slice(&k);
+            dropped.extend_from_slice(&d);
+        },
+    );
+    kept.map_err(|bad| bad.error(err))
+}
+
+impl Bad {
+    /// The error the serial pass gave for this problem.
+    fn error(self, err: &dyn Fn(String) -> Error) -> Error {
+        match self {
+            Bad::Vertex(i, p) => err(format!("vertex {i} has a non-finite coordinate {p}")),
+            Bad::Placed(i) => Error::Setting {
+                name: "scale",
+                message: format!(
+                    "vertex {i} leaves f32's range after the transform: the scale or translation is too large"
+                ),
+            },
+            Bad::Index(f, bad, nv) => {
+                err(format!("triangle {f}: vertex index {bad} out of range (there are {nv} vertices)"))
+            }
         }
-        assert!(hits > n_rays / 10, "{hits} hits");
-    }
-
-    #[test]
-    fn bunny_obj_matches_brute_force() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/bunny.obj");
-        let m = Mesh::load(&path, &Transform::default()).unwrap();
-        println!("bunny: {} triangles, {} degenerate dropped", m.triangle_count(), m.degenerate_dropped());
-        assert_eq!(m.triangle_count() + m.degenerate_dropped(), 3674);
-        check_against_brute_force(&m, 10_000, 1);
-    }
-
-    #[test]
-    fn dragon_ply_gz_matches_brute_force() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/dragon_vrip_res4.ply.gz");
-        if !path.exists() {
-            println!("skipped: {} not found (shared/ is expected beside the repository)", path.display());
-            return;
-        }
-        let m = Mesh::load(&path, &Transform::default()).unwrap();
-        println!("dragon res4: {} triangles, {} degenerate dropped", m.triangle_count(), m.degenerate_dropped());
-        assert_eq!(m.triangle_count() + m.degenerate_dropped(), 11_102);
-        check_against_brute_force(&m, 10_000, 2);
-    }
-
-    #[test]
-    fn face_index_counts_dropped_triangles() {
-        let pos: Vec<Vec3> = (0..12).map(|i| Vec3::new(i as f32, (i * i % 7) as f32, (i % 3) as f32)).collect();
-        // Faces 0, 3, 4 and 7 are degenerate (repeated vertex).
-        let faces: Vec<[u32; 3]> = (0..9u32)
-            .map(|f| if [0, 3, 4, 7].contains(&f) { [f, f, f + 1] } else { [f, f + 1, f + 2 + (f % 2)] })
-            .collect();
-        let m = Mesh::from_triangles(pos.clone(), faces.clone(), None).unwrap();
-        assert_eq!(m.degenerate_dropped(), 4);
-        let mut seen: Vec<u32> = (0..m.triangle_count() as u32)
-            .map(|k| {
-                let f = m.face_index(k);
-                assert_eq!(m.triangle(k), faces[f as usize].map(|i| pos[i as usize]), "slot {k} -> face {f}");
-                f
-            })
-            .collect();
-        seen.sort();
-        assert_eq!(seen, vec![1, 2, 5, 6, 8]);
-    }
-
-    #[test]
-    fn transform_and_normals() {
-        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
-        let t =
-            Transform { scale: Vec3::new(2.0, 3.0, 1.0), rotate_deg: Vec3::new(0.0, 0.0, 90.0), translate: Vec3::Z };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &t, None, &|m| Error::Settings(m)).unwrap();
-        let [a, b, c] = m.triangle(0);
-        assert!((a - Vec3::Z).length() < 1e-6);
-        assert!((b - Vec3::new(0.0, 2.0, 1.0)).length() < 1e-6, "{b}");
-        assert!((c - Vec3::new(-3.0, 0.0, 1.0)).length() < 1e-6, "{c}");
-        // Mirroring keeps the front side (normal +z before and after).
-        let mirror = Transform { scale: Vec3::new(-1.0, 1.0, 1.0), ..Default::default() };
-        let m = Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &mirror, None, &|m| Error::Settings(m)).unwrap();
-        let h = m.intersect(&Ray::new(Vec3::new(-0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
-        assert_eq!(h.n, Vec3::Z);
-        assert!(
-            Mesh::build(pos.clone(), vec![[0, 1, 2]], None, None, &Transform { scale: Vec3::ZERO, ..t }, None, &|m| {
-                Error::Settings(m)
-            })
-            .is_err()
-        );
-        // Interpolated vertex normals, flipped into n's hemisphere.
-        let ns = vec![Vec3::new(0.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(0.0, 0.0, -1.0)];
-        let m = Mesh::from_triangles(pos.clone(), vec![[0, 1, 2]], Some(ns)).unwrap();
-        let h = m.intersect(&Ray::new(Vec3::new(0.5, 0.25, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
-        assert!(h.ns.z > 0.0 && h.ns.x < 0.0 && (h.ns.length() - 1.0).abs() < 1e-6, "{}", h.ns);
-        let e = Mesh::from_triangles(pos, vec![[0, 1, 3]], None).unwrap_err();
-        assert!(matches!(e, Error::Settings(_)) && e.to_string().contains("out of range"));
-    }
-
-    #[test]
-    fn uv_interpolates_vertex_uvs_or_takes_pbrts_default() {
-        // A square whose uvs are its (x, y): the uv at any hit is the hit's (x, y).
-        let pos = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
-        let uvs = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        let data =
-            MeshData { positions: pos.clone(), triangles: vec![[0, 1, 2], [0, 2, 3]], normals: None, uvs: Some(uvs) };
-        let m = Mesh::from_parts(data, &Transform::default(), None, &Error::Settings).unwrap();
-        let mut rng = Pcg32::new(5, 1);
-        for _ in 0..200 {
-            let (x, y) = (uniform(&mut rng), uniform(&mut rng));
-            let h = m.intersect(&Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
-            // Barycentrics of the hit in the stored triangle (in the z = 0 plane).
-            let [p0, p1, p2] = m.triangle(h.prim);
-            let (e1, e2, q) = (p1 - p0, p2 - p0, h.p - p0);
-            let det = e1.x * e2.y - e1.y * e2.x;
-            let (b1, b2) = ((q.x * e2.y - q.y * e2.x) / det, (e1.x * q.y - e1.y * q.x) / det);
-            let uv = m.uv(h.prim, b1, b2);
-            assert!((uv[0] - x).abs() < 1e-5 && (uv[1] - y).abs() < 1e-5, "({x}, {y}): {uv:?}");
-        }
-        // Without uvs: (0, 0), (1, 0), (1, 1) at the vertices, linear between.
-        let m = Mesh::from_triangles(pos, vec![[0, 1, 2]], None).unwrap();
-        assert!(m.uvs.is_none() && m.vert_idx.is_empty(), "no cost without uvs");
-        assert_eq!([m.uv(0, 0.0, 0.0), m.uv(0, 1.0, 0.0), m.uv(0, 0.0, 1.0)], [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]);
-        assert_eq!(m.uv(0, 0.5, 0.25), [0.75, 0.25]);
     }
 }
+
+#[cfg(test)]
+mod tests;
