@@ -325,6 +325,15 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         let field = if i < desc.objects.len() { format!("objects[{i}].interior") } else { "camera.medium".into() };
         return Err(ctx.err(field, "a Grid medium: whitted does not track media; use auto, path or spectral"));
     }
+    if let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.scatters() || m.is_grid()))
+        && settings.integrator == IntegratorKind::Caustics
+    {
+        let field = if i < desc.objects.len() { format!("objects[{i}].interior") } else { "camera.medium".into() };
+        return Err(ctx.err(
+            field,
+            "--integrator caustics: scenes with media are not supported yet (an absorbing dielectric is); use bdpt",
+        ));
+    }
 
     let c = &desc.camera;
     let eye = ctx.vec("camera.eye", c.eye)?;
@@ -580,10 +589,10 @@ fn lens_camera(
             return Err(ctx.err(field, "not with a `lens`: the lens's own fields set the view, aperture and focus"));
         }
     }
-    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace) {
+    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace | IntegratorKind::Caustics) {
         return Err(ctx.err(
             "camera.lens",
-            "bdpt and lighttrace need the camera's importance, which a lens system does not define (as in pbrt-v4); use auto, path, spectral or whitted",
+            "bdpt, lighttrace and caustics need the camera's importance, which a lens system does not define (as in pbrt-v4); use auto, path, spectral or whitted",
         ));
     }
     let aperture = ctx.positive("camera.lens.aperture_diameter_mm", lens.aperture_diameter_mm)?;

@@ -1,0 +1,326 @@
+//! `--integrator caustics`: path tracing, with the caustics of the
+//! environment and of distant lights traced from the lights (issue 35).
+//!
+//! # A partition of path space
+//! Write a path `E X1 X2 … Xk L` (`E` the eye, `X1` the first vertex seen
+//! from the camera, `Xk` the last before the light). The **light side** owns
+//! the paths with `k ≥ 2` whose `X1` scattered through a non-delta lobe,
+//! whose `Xk` scattered through a delta lobe (smooth glass, mirror, smooth
+//! metal, thin sheet, a smooth Plastic's coat) and whose light `L` is
+//! *aimed*: the environment (map, uniform or sky with its sun) or a distant
+//! light. The **camera side** owns every other path. Each camera sample adds
+//! the two estimates:
+//!
+//! - the camera side is `auto`'s path tracer ([`PathTracer`] with
+//!   `light_caustics`): an escape to the environment through a delta lobe on
+//!   a path whose first vertex scattered through a non-delta lobe adds 0.
+//!   Next-event estimation never goes through a delta lobe, so it is
+//!   untouched; distant lights are never hit by a camera path (today's `path`
+//!   simply misses their caustics);
+//! - the light side is one light subpath ([`Bdpt::caustic_splats`]): an
+//!   aimed light chosen by power among the aimed lights ([`Aim::choose_light`]),
+//!   its direction as the light draws it, the ray's origin drawn on one of
+//!   the disks that cover the bounding spheres of the objects with a delta
+//!   lobe ([`Aim::sample_origin`]), perpendicular to the direction and
+//!   upstream of the scene. If its first surface vertex `y1` did not scatter
+//!   through a delta lobe, the subpath ends (that path is the camera side's);
+//!   otherwise every later vertex `y_i`, `i ≥ 2`, is connected to the eye
+//!   with weight 1 (no MIS) and splatted, as `lighttrace`'s are. The path
+//!   `E y_i … y1 y0` then has `X1 = y_i` (non-delta: a connection evaluates
+//!   only the non-delta part of its BSDF), `Xk = y1` (delta) and `k = i ≥ 2`:
+//!   exactly the light side's paths, each made once.
+//!
+//! Both sides are unbiased estimators of their parts of the measurement
+//! (their sampling densities are positive wherever the parts are nonzero:
+//! every ray of an aimed light that reaches a delta object passes through
+//! that object's disk), so their sum is unbiased by linearity, with no MIS
+//! weights. A material with a delta and a non-delta lobe (Plastic) splits the
+//! same way per lobe: the camera side keeps its non-delta lobe's paths
+//! (next-event estimation and the MIS-weighted escape), the light side its
+//! delta lobe's.
+//!
+//! # Aiming
+//! For a parallel bundle of direction `ω` the origin's density per area on
+//! the plane perpendicular to `ω` is the mixture `Σ_k P_k [x ∈ disk_k] /
+//! (π r_k²)` ([`Aim::pdf_origin`]): disks overlap, and a point in several
+//! counts every disk that holds it. Targets are picked with probability
+//! `P_k ∝ r_k²` (where disks do not overlap the origin is then uniform over
+//! their union). A ray through a disk that first meets a non-delta object is
+//! wasted; a ray that could reach a delta object and lies in no disk cannot
+//! exist (the disk is the sphere's whole shadow).
+//!
+//! # Wavelengths and sampler dimensions
+//! The camera side is `auto`'s (full spectrum, collapsing at dispersive
+//! glass by throughput), the light side BDPT's fixed draw `u_λ`, taken from
+//! [`Dim::wavelength`]`(1)`, which `auto`'s path tracer never draws. The
+//! light side's other draws are [`Dim::EMIT_CHOICE`], [`Dim::EMIT_POSITION`],
+//! [`Dim::EMIT_DIRECTION`] and the light subpath's own per-bounce block, so
+//! the two sides share no number (a pinhole camera; a lens system is
+//! refused, as for `bdpt`).
+//!
+//! # Limits
+//! Paths whose first bounce from the light is diffuse stay with the camera
+//! side (the caustic seen in a mirror, say, is the camera side's); area
+//! lights, point and spot lights are not aimed (their caustics stay as
+//! `path` finds them: none for point and spot lights); an object with a
+//! delta lobe and no bounds (a mirror plane) leaves no disk to aim at, and
+//! then `caustics` is path tracing alone, as it is without a delta surface
+//! or an aimed light. Scenes with scattering media are refused at load.
+//!
+//! [`Dim::wavelength`]: crate::sampler::Dim::wavelength
+//! [`Dim::EMIT_CHOICE`]: crate::sampler::Dim::EMIT_CHOICE
+//! [`Dim::EMIT_POSITION`]: crate::sampler::Dim::EMIT_POSITION
+//! [`Dim::EMIT_DIRECTION`]: crate::sampler::Dim::EMIT_DIRECTION
+
+use std::f32::consts::PI;
+
+use glam::{Vec2, Vec3};
+
+use crate::film::Splat;
+use crate::geometry::Frame;
+use crate::light::Light;
+use crate::sampler::Sampler;
+use crate::sampler::warp::concentric_disk;
+use crate::scene::Scene;
+use crate::spectral::Contribution;
+
+use super::{Bdpt, Estimator, FullSpectrum, PathTracer};
+
+/// A disk to aim at: the bounding sphere of an object with a delta lobe.
+#[derive(Clone, Copy, Debug)]
+struct Target {
+    center: Vec3,
+    radius: f32,
+    /// The probability of picking it.
+    p: f32,
+}
+
+/// Where `caustics`' light side aims: the aimed lights with their choice
+/// probabilities, and the targets.
+#[derive(Clone, Debug)]
+pub(crate) struct Aim {
+    targets: Vec<Target>,
+    /// Cumulative target probabilities.
+    target_cdf: Vec<f32>,
+    /// The aimed lights' indices and probabilities (by power).
+    lights: Vec<(u32, f32)>,
+    /// Cumulative light probabilities.
+    light_cdf: Vec<f32>,
+    /// The scene's radius: rays start `2R + r_k` upstream of target `k`'s
+    /// centre, beyond everything bounded.
+    scene_radius: f32,
+}
+
+impl Aim {
+    /// The aim for `scene`, or `None` when there is nothing to aim (no aimed
+    /// light with power, no object with a delta lobe, or an unbounded one).
+    pub(crate) fn new(scene: &Scene) -> Option<Aim> {
+        let spheres = scene.delta_targets()?;
+        let spheres: Vec<(Vec3, f32)> =
+            spheres.into_iter().filter(|(c, r)| c.is_finite() && r.is_finite() && *r > 0.0).collect();
+        let lights: Vec<(u32, f32)> = (0..scene.light_count() as u32)
+            .filter(|&i| matches!(scene.light(i), Light::Environment(_) | Light::Distant(_)))
+            .map(|i| (i, scene.light(i).power().max(0.0)))
+            .filter(|(_, p)| p.is_finite() && *p > 0.0)
+            .collect();
+        Aim::from_parts(&spheres, &lights, scene.radius())
+    }
+
+    /// The aim at `spheres` (centre, radius) for lights `(index, power)`.
+    fn from_parts(spheres: &[(Vec3, f32)], lights: &[(u32, f32)], scene_radius: f32) -> Option<Aim> {
+        let area: f32 = spheres.iter().map(|(_, r)| r * r).sum();
+        let power: f32 = lights.iter().map(|(_, p)| p).sum();
+        if spheres.is_empty() || lights.is_empty() || !(area > 0.0 && power > 0.0) {
+            return None;
+        }
+        let targets: Vec<Target> =
+            spheres.iter().map(|&(center, radius)| Target { center, radius, p: radius * radius / area }).collect();
+        let cdf = |ps: &mut dyn Iterator<Item = f32>| {
+            let mut acc = 0.0;
+            let mut c: Vec<f32> = ps
+                .map(|p| {
+                    acc += p;
+                    acc
+                })
+                .collect();
+            // The last entry exactly 1, so every u < 1 finds one.
+            if let Some(last) = c.last_mut() {
+                *last = 1.0;
+            }
+            c
+        };
+        let lights: Vec<(u32, f32)> = lights.iter().map(|&(i, p)| (i, p / power)).collect();
+        Some(Aim {
+            target_cdf: cdf(&mut targets.iter().map(|t| t.p)),
+            light_cdf: cdf(&mut lights.iter().map(|l| l.1)),
+            targets,
+            lights,
+            scene_radius,
+        })
+    }
+
+    /// How many lights are aimed.
+    pub(crate) fn light_count(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// How many targets there are.
+    pub(crate) fn target_count(&self) -> usize {
+        self.targets.len()
+    }
+
+    /// An aimed light chosen with `u`, by power: its index and probability.
+    pub(crate) fn choose_light(&self, u: f32) -> Option<(u32, f32)> {
+        let k = self.light_cdf.partition_point(|&c| c <= u).min(self.lights.len().checked_sub(1)?);
+        Some(self.lights[k])
+    }
+
+    /// The origin of a ray travelling along unit `dir`, drawn with `u`: a
+    /// target `k` with probability `P_k` (by `u.x`, then rescaled), a point
+    /// uniform on its disk perpendicular to `dir`, moved upstream beyond the
+    /// scene. Returns the point and its density per area on that plane,
+    /// [`Aim::pdf_origin`].
+    pub(crate) fn sample_origin(&self, dir: Vec3, u: Vec2) -> Option<(Vec3, f32)> {
+        let k = self.target_cdf.partition_point(|&c| c <= u.x).min(self.targets.len() - 1);
+        let lo = if k == 0 { 0.0 } else { self.target_cdf[k - 1] };
+        let t = &self.targets[k];
+        let ux = ((u.x - lo) / t.p).clamp(0.0, 1.0 - f32::EPSILON);
+        let q = concentric_disk(Vec2::new(ux, u.y)) * t.radius;
+        let upstream = 2.0 * self.scene_radius + t.radius;
+        let point = t.center + Frame::from_z(dir).to_world(Vec3::new(q.x, q.y, 0.0)) - dir * upstream;
+        let pdf = self.pdf_origin(point, dir);
+        (pdf.is_finite() && pdf > 0.0).then_some((point, pdf))
+    }
+
+    /// The density per area, on the plane perpendicular to `dir`, with which
+    /// [`Aim::sample_origin`] draws a ray through `point`: the mixture
+    /// `Σ_k P_k [point ∈ disk_k] / (π r_k²)`.
+    pub(crate) fn pdf_origin(&self, point: Vec3, dir: Vec3) -> f32 {
+        self.targets
+            .iter()
+            .filter(|t| {
+                let d = point - t.center;
+                let perp = d - dir * d.dot(dir);
+                perp.length_squared() <= t.radius * t.radius
+            })
+            .map(|t| t.p / (PI * t.radius * t.radius))
+            .sum()
+    }
+}
+
+/// The `caustics` estimator: the camera side's path tracing plus the light
+/// side's splats (see the module doc).
+pub(crate) struct Caustics {
+    /// `auto`'s path tracer with `light_caustics` set.
+    pub camera: FullSpectrum,
+    /// Light tracing (`light_only`), for its aimed subpath and connections.
+    pub light: Bdpt,
+    /// The aimed lights and the targets.
+    pub aim: Aim,
+}
+
+impl Caustics {
+    /// The estimator for `scene` with bounce limit `max_bounces`; `None` when
+    /// there is nothing to aim ([`Aim::new`]).
+    pub(crate) fn new(scene: &Scene, max_bounces: u32, collapse_to: u32) -> Option<Caustics> {
+        let aim = Aim::new(scene)?;
+        let path = PathTracer { max_bounces, disperse: true, collapse_to, light_caustics: true };
+        Some(Caustics {
+            camera: FullSpectrum(super::Transport::Path(path)),
+            light: Bdpt { max_bounces, light_only: true },
+            aim,
+        })
+    }
+}
+
+impl Estimator for Caustics {
+    fn sample<O: Contribution>(
+        &self,
+        scene: &Scene,
+        film: Vec2,
+        sampler: &mut Sampler,
+        splats: &mut Vec<Splat<O>>,
+    ) -> O {
+        let camera = self.camera.sample(scene, film, sampler, splats);
+        self.light.caustic_splats(scene, &self.aim, sampler, splats);
+        camera
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::Sampler;
+
+    /// Three overlapping disks and one apart, seen along several directions:
+    /// `E[1/pdf_origin]` over drawn points is the area of the disks' union
+    /// on the plane (a Monte Carlo estimate of the area; the union's area is
+    /// computed independently on a fine grid over the plane), and every
+    /// drawn point has a positive density and lies upstream of the scene.
+    #[test]
+    fn the_mixture_density_integrates_to_the_union_of_the_disks() {
+        let spheres = [
+            (Vec3::new(0.0, 0.0, 0.0), 1.0),
+            (Vec3::new(0.8, 0.3, 0.1), 0.6),
+            (Vec3::new(0.2, -0.5, 0.4), 0.3),
+            (Vec3::new(4.0, 1.0, -2.0), 0.5),
+        ];
+        let scene_radius = 6.0;
+        let aim = Aim::from_parts(&spheres, &[(0, 1.0)], scene_radius).unwrap();
+        let dirs = [Vec3::new(0.0, -1.0, 0.0), Vec3::new(1.0, -2.0, 0.5).normalize(), Vec3::new(-0.3, 0.1, 1.0).normalize()];
+        let mut s = Sampler::new(3, 1, 4);
+        for dir in dirs {
+            // The union's area on a grid of the plane perpendicular to `dir`.
+            let frame = Frame::from_z(dir);
+            let discs: Vec<(Vec2, f32)> = spheres
+                .iter()
+                .map(|&(c, r)| {
+                    let l = frame.to_local(c);
+                    (Vec2::new(l.x, l.y), r)
+                })
+                .collect();
+            let (n, lo, hi) = (2000, -6.0f64, 6.0f64);
+            let cell = (hi - lo) / n as f64;
+            let mut inside = 0u64;
+            for i in 0..n {
+                for j in 0..n {
+                    let p = Vec2::new((lo + (i as f64 + 0.5) * cell) as f32, (lo + (j as f64 + 0.5) * cell) as f32);
+                    if discs.iter().any(|(c, r)| (p - *c).length_squared() <= r * r) {
+                        inside += 1;
+                    }
+                }
+            }
+            let union = inside as f64 * cell * cell;
+            let m = 200_000;
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for _ in 0..m {
+                let (p, pdf) = aim.sample_origin(dir, s.next_2d()).expect("a point on a disk");
+                assert!(pdf > 0.0 && pdf == aim.pdf_origin(p, dir));
+                // Upstream of everything within the scene's radius of any target's centre.
+                for (c, _) in spheres {
+                    assert!((p - c).dot(dir) < -scene_radius, "{p} not upstream along {dir}");
+                }
+                let x = 1.0 / pdf as f64;
+                sum += x;
+                sum2 += x * x;
+            }
+            let mean = sum / m as f64;
+            let se = ((sum2 / m as f64 - mean * mean).max(0.0) / m as f64).sqrt();
+            eprintln!("union {union:.4}, E[1/pdf] {mean:.4} ± {se:.4} along {dir}");
+            assert!((mean - union).abs() < 5.0 * se + 2e-3 * union, "{mean} ± {se} vs {union}");
+        }
+    }
+
+    /// Lights are chosen by power among the aimed ones, with the probability
+    /// returned; targets by area.
+    #[test]
+    fn lights_by_power_targets_by_area() {
+        let aim = Aim::from_parts(&[(Vec3::ZERO, 1.0), (Vec3::X * 3.0, 2.0)], &[(2, 1.0), (5, 3.0)], 5.0).unwrap();
+        assert_eq!(aim.choose_light(0.1), Some((2, 0.25)));
+        assert_eq!(aim.choose_light(0.3), Some((5, 0.75)));
+        assert_eq!(aim.choose_light(1.0 - f32::EPSILON), Some((5, 0.75)));
+        assert!((aim.targets[0].p - 0.2).abs() < 1e-6 && (aim.targets[1].p - 0.8).abs() < 1e-6);
+        assert!(Aim::from_parts(&[], &[(0, 1.0)], 1.0).is_none());
+        assert!(Aim::from_parts(&[(Vec3::ZERO, 1.0)], &[], 1.0).is_none());
+    }
+}
