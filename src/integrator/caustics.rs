@@ -267,7 +267,8 @@ mod tests {
         ];
         let scene_radius = 6.0;
         let aim = Aim::from_parts(&spheres, &[(0, 1.0)], scene_radius).unwrap();
-        let dirs = [Vec3::new(0.0, -1.0, 0.0), Vec3::new(1.0, -2.0, 0.5).normalize(), Vec3::new(-0.3, 0.1, 1.0).normalize()];
+        let dirs =
+            [Vec3::new(0.0, -1.0, 0.0), Vec3::new(1.0, -2.0, 0.5).normalize(), Vec3::new(-0.3, 0.1, 1.0).normalize()];
         let mut s = Sampler::new(3, 1, 4);
         for dir in dirs {
             // The union's area on a grid of the plane perpendicular to `dir`.

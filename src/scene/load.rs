@@ -589,10 +589,16 @@ fn lens_camera(
             return Err(ctx.err(field, "not with a `lens`: the lens's own fields set the view, aperture and focus"));
         }
     }
-    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace | IntegratorKind::Caustics) {
+    if settings.integrator == IntegratorKind::Caustics {
         return Err(ctx.err(
             "camera.lens",
-            "bdpt, lighttrace and caustics need the camera's importance, which a lens system does not define (as in pbrt-v4); use auto, path, spectral or whitted",
+            "caustics splats light subpaths to the camera, which needs the camera's importance, which a lens system does not define; use auto, path, spectral or whitted",
+        ));
+    }
+    if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace) {
+        return Err(ctx.err(
+            "camera.lens",
+            "bdpt and lighttrace need the camera's importance, which a lens system does not define (as in pbrt-v4); use auto, path, spectral or whitted",
         ));
     }
     let aperture = ctx.positive("camera.lens.aperture_diameter_mm", lens.aperture_diameter_mm)?;
