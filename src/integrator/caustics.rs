@@ -17,7 +17,9 @@
 //!   Next-event estimation never goes through a delta lobe, so it is
 //!   untouched; distant lights are never hit by a camera path (today's `path`
 //!   simply misses their caustics);
-//! - the light side is one light subpath ([`Bdpt::caustic_splats`]): an
+//! - the light side is, with probability [`LIGHT_FRACTION`] (1/16) per
+//!   camera sample (its splats weighted by the inverse), one light subpath
+//!   ([`Bdpt::caustic_splats`]): an
 //!   aimed light chosen by power among the aimed lights ([`Aim::choose_light`]),
 //!   its direction as the light draws it, the ray's origin drawn on one of
 //!   the disks that cover the bounding spheres of the objects with a delta
@@ -52,7 +54,8 @@
 //! # Wavelengths and sampler dimensions
 //! The camera side is `auto`'s (full spectrum, collapsing at dispersive
 //! glass by throughput), the light side BDPT's fixed draw `u_λ`, taken from
-//! [`Dim::wavelength`]`(1)`, which `auto`'s path tracer never draws. The
+//! [`Dim::wavelength`]`(1)`, which `auto`'s path tracer never draws; whether
+//! a sample traces a light subpath at all is [`Dim::wavelength`]`(2)`'s. The
 //! light side's other draws are [`Dim::EMIT_CHOICE`], [`Dim::EMIT_POSITION`],
 //! [`Dim::EMIT_DIRECTION`] and the light subpath's own per-bounce block, so
 //! the two sides share no number (a pinhole camera; a lens system is
@@ -79,8 +82,8 @@ use glam::{Vec2, Vec3};
 use crate::film::Splat;
 use crate::geometry::Frame;
 use crate::light::Light;
-use crate::sampler::Sampler;
 use crate::sampler::warp::concentric_disk;
+use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::Contribution;
 
@@ -208,6 +211,16 @@ impl Aim {
     }
 }
 
+/// The probability that a camera sample also traces a light subpath (whose
+/// splats are then weighted by its inverse: unbiased). On
+/// `scenes/environment.ron` at 192x128 (32 spp, one thread, against a
+/// 4096-spp reference) MSE × time relative to `path`'s was 1.19 with a
+/// light subpath per sample (q = 1), 0.63 at 1/4, 0.54 at 1/8, 0.50 at
+/// 1/16, 0.45 at 1/32, 0.46 at 1/64: the light subpaths cost as much as the
+/// camera paths, and one per 16 camera samples already takes the caustic's
+/// error far below the rest of the image's.
+const LIGHT_FRACTION: f32 = 1.0 / 16.0;
+
 /// The `caustics` estimator: the camera side's path tracing plus the light
 /// side's splats (see the module doc).
 pub(crate) struct Caustics {
@@ -242,7 +255,9 @@ impl Estimator for Caustics {
         splats: &mut Vec<Splat<O>>,
     ) -> O {
         let camera = self.camera.sample(scene, film, sampler, splats);
-        self.light.caustic_splats(scene, &self.aim, sampler, splats);
+        if sampler.get_1d(Dim::wavelength(2)) < LIGHT_FRACTION {
+            self.light.caustic_splats(scene, &self.aim, sampler, splats, 1.0 / LIGHT_FRACTION);
+        }
         camera
     }
 }

@@ -250,13 +250,14 @@ impl Bdpt {
     /// camera side never draws), and, when its first surface vertex
     /// scattered through a delta lobe, every later vertex `y_i`, `i ≥ 2`,
     /// connected to the eye (`t = 1`, weight 1, as `lighttrace`'s: `self`
-    /// is `light_only`) and splatted to `splats`.
+    /// is `light_only`) and splatted to `splats`, scaled by `weight`.
     pub(crate) fn caustic_splats<O: Contribution>(
         &self,
         scene: &Scene,
         aim: &Aim,
         sampler: &mut Sampler,
         splats: &mut Vec<Splat<O>>,
+        weight: f32,
     ) {
         debug_assert!(self.light_only, "caustics' light side is unweighted");
         PATHS.with(|paths| {
@@ -278,8 +279,10 @@ impl Bdpt {
             for s in 3..=light.v.len().min(max + 1) {
                 if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, sampler, &mut wl) {
                     let value = match c {
-                        Contrib::Full(c) => O::from_packet(&scene.sensor, &full, &c),
-                        Contrib::Single(v) => O::from_packet(&scene.sensor, &wl.single().lambdas, &Sampled([v])),
+                        Contrib::Full(c) => O::from_packet(&scene.sensor, &full, &(c * weight)),
+                        Contrib::Single(v) => {
+                            O::from_packet(&scene.sensor, &wl.single().lambdas, &Sampled([v * weight]))
+                        }
                     };
                     splats.push(Splat { x: pixel.x as u32, y: pixel.y as u32, value });
                 }
