@@ -8,7 +8,7 @@
 //! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
 //! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
 //! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface: bins, or continuous wavelengths where glass disperses (`--wavelengths continuous`: everywhere); or `--wavelengths rgb` |
-//! | `caustics` | as `path`, but the caustics of the environment and distant lights through specular surfaces come from light subpaths aimed at those surfaces, splatted to the camera (a partition of path space, no MIS; [`caustics`]) | as `auto` on the camera side; BDPT's one collapsed wavelength on the light side |
+//! | `caustics` | as `path`, but the caustics of the environment and distant lights through specular surfaces come from light subpaths aimed at those surfaces, splatted to the camera (a partition of path space, no MIS; the crate-internal `caustics` module) | as `auto` on the camera side; BDPT's one collapsed wavelength on the light side |
 //! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own at a continuous wavelength within its bin: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`

@@ -333,7 +333,7 @@ impl Bdpt {
     }
 
     /// The light subpath of `caustics`' light side: an aimed light by
-    /// [`Aim::choose_light`], its direction as [`Light::sample_le`] draws it,
+    /// [`Aim::choose_light`], its direction as [`crate::light::Light::sample_le`] draws it,
     /// the ray's origin on the targets' disks ([`Aim::sample_origin`]); the
     /// walk ends at its first surface vertex unless that scattered through a
     /// delta lobe.
