@@ -358,10 +358,12 @@ fn describe_transport(scene: &Scene) -> String {
         IntegratorKind::Path => "path: full-spectrum path tracing".into(),
         IntegratorKind::Bdpt => "bdpt: bidirectional path tracing, every strategy combined by MIS (power heuristic)".into(),
         IntegratorKind::LightTrace => "lighttrace: light subpaths connected to the camera only (no camera paths)".into(),
-        IntegratorKind::Caustics => match caustics::Aim::new(scene) {
-            Some(aim) => format!(
-                "caustics: auto's path tracing, except caustics of the environment and distant lights through specular surfaces: light subpaths aimed at {} specular object(s) connect them to the camera (no MIS: a partition of the paths)",
-                aim.target_count()
+        IntegratorKind::Caustics => match Caustics::new(scene, s.max_bounces, s.packet_size) {
+            Some(c) => format!(
+                "caustics: auto's path tracing, except caustics of the environment and distant lights through specular surfaces: light subpaths aimed at {} specular object(s) ({:.0}% of aimed rays reach one; a light subpath for {:.1}% of the samples) connect them to the camera (no MIS: a partition of the paths)",
+                c.aim.target_count(),
+                100.0 * c.aim.reach(scene),
+                100.0 * c.fraction
             ),
             None => "caustics: no specular surface with bounds, or no environment or distant light, to aim at: auto's full-spectrum path tracing alone".into(),
         },

@@ -244,12 +244,8 @@ impl Scene {
     /// when such an object is unbounded (no sphere holds it).
     pub fn delta_targets(&self) -> Option<Vec<(Vec3, f32)>> {
         let mut targets = Vec::new();
-        for o in &self.objects {
-            let delta = self.leaves(&o.material).iter().any(|&m| {
-                let m = &self.materials[m as usize];
-                m.has_delta_lobe() && !m.is_interface()
-            });
-            if delta {
+        for (i, o) in self.objects.iter().enumerate() {
+            if self.may_scatter_delta(i as u32) {
                 // A sphere is its own bounding sphere (its box's is √3 times as wide).
                 if let crate::shape::Shape::Sphere(s) = &o.shape {
                     targets.push((s.center, s.radius));
@@ -260,6 +256,15 @@ impl Scene {
             }
         }
         Some(targets)
+    }
+
+    /// True when a hit on object `object` may scatter through a delta lobe
+    /// ([`Bxdf::has_delta_lobe`] of any material it may have; not an `Interface`).
+    pub fn may_scatter_delta(&self, object: u32) -> bool {
+        self.leaves(&self.objects[object as usize].material).iter().any(|&m| {
+            let m = &self.materials[m as usize];
+            m.has_delta_lobe() && !m.is_interface()
+        })
     }
 
     /// The emission leaving surface hit `si` back along `dir` (the direction
