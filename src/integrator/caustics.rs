@@ -245,7 +245,8 @@ impl Aim {
 /// light subpath per sample (q = 1), 0.63 at 1/4, 0.54 at 1/8, 0.50 at
 /// 1/16, 0.45 at 1/32, 0.46 at 1/64: the light subpaths cost as much as the
 /// camera paths, and one per 16 camera samples already takes the caustic's
-/// error far below the rest of the image's.
+/// error far below the rest of the image's (85% of the aimed rays reach the
+/// glass there, so [`Caustics::new`] traces a light subpath for 7.4%).
 const LIGHT_FRACTION: f32 = 1.0 / 16.0;
 
 /// How many aimed rays [`Aim::reach`] traces.
