@@ -366,6 +366,34 @@ mod tests {
         }
     }
 
+    /// The pilot's share of aimed rays that reach a delta surface: a
+    /// distant light straight down on a glass sphere whose disk a diffuse
+    /// quad half covers (x < 0, above the sphere) gives ½ (1024 rays: s.e.
+    /// 0.016, so within 0.06); the rate is then 1/16 ÷ ½ = 1/8; uncovered,
+    /// every ray reaches the glass and the rate is 1/16.
+    #[test]
+    fn the_pilot_measures_the_share_of_aimed_rays_that_reach_the_glass() {
+        let scene = |blocker: &str| {
+            let text = format!(
+                r#"(camera: (eye: (0, 1, 5), look_at: (0, 0, 0), fov_deg: 30),
+                materials: {{ "glass": Dielectric(ior: Constant(1.5)), "grey": Lambertian(reflectance: Constant(0.5)) }},
+                objects: [ (shape: Sphere(center: (0, 0, 0), radius: 0.5), material: "glass"), {blocker} ],
+                lights: [ Distant(direction: (0, -1, 0), irradiance: Constant(1)) ])"#
+            );
+            crate::scene::load_scene_str(&text, std::path::Path::new("t.ron"), &Default::default()).unwrap()
+        };
+        let half =
+            scene(r#"(shape: Quad(origin: (-2, 1, -2), edge_u: (2, 0, 0), edge_v: (0, 0, 4)), material: "grey")"#);
+        let c = Caustics::new(&half, 8, 4).unwrap();
+        let reach = c.aim.reach(&half);
+        assert!((reach - 0.5).abs() < 0.06, "half covered: {reach}");
+        assert!((c.fraction - LIGHT_FRACTION / reach).abs() < 1e-6);
+        let open =
+            scene(r#"(shape: Quad(origin: (-2, -3, -2), edge_u: (4, 0, 0), edge_v: (0, 0, 4)), material: "grey")"#);
+        let c = Caustics::new(&open, 8, 4).unwrap();
+        assert_eq!((c.aim.reach(&open), c.fraction), (1.0, LIGHT_FRACTION));
+    }
+
     /// Lights are chosen by power among the aimed ones, with the probability
     /// returned; targets by area.
     #[test]
