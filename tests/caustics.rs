@@ -123,6 +123,22 @@ fn a_distant_lights_caustic_that_path_tracing_misses() {
     assert!(caustics[k].0 - path[k].0 > 10.0 * se(&caustics[k], &path[k]), "caustics misses the caustic");
 }
 
+/// A point light and a spot light over the glass sphere: their caustics
+/// (which path tracing cannot see) come from light subpaths aimed by the
+/// cone mixture; every block agrees with BDPT's, the caustic's included.
+#[test]
+fn point_and_spot_light_caustics_match_bdpt() {
+    for light in [
+        "lights: [ Point(position: (0.3, 2.2, 0.2), intensity: Constant(4)) ],",
+        "lights: [ Spot(position: (0.3, 2.2, 0.2), look_at: (0, 0, 0), cone_deg: 30, falloff_deg: 10, intensity: Constant(4)) ],",
+    ] {
+        let text = glass_over_floor(light);
+        let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
+        let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+        assert_blocks_agree(&format!("{light} caustics vs bdpt"), &caustics, &bdpt);
+    }
+}
+
 /// A wall with a hole between a distant light and the glass sphere: most
 /// aimed rays hit the wall, so a light subpath is traced for more of the
 /// samples (and weighted less); `caustics` still agrees with BDPT block by

@@ -8,7 +8,7 @@
 //! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
 //! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
 //! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface: bins, or continuous wavelengths where glass disperses (`--wavelengths continuous`: everywhere); or `--wavelengths rgb` |
-//! | `caustics` | as `path`, but the caustics of the environment and distant lights through specular surfaces come from light subpaths aimed at those surfaces, splatted to the camera (a partition of path space, no MIS; the crate-internal `caustics` module) | as `auto` on the camera side; BDPT's one collapsed wavelength on the light side |
+//! | `caustics` | as `path`, but the caustics of the environment and distant, point and spot lights through specular surfaces come from light subpaths aimed at those surfaces, splatted to the camera (a partition of path space, no MIS; the crate-internal `caustics` module) | as `auto` on the camera side; BDPT's one collapsed wavelength on the light side |
 //! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own at a continuous wavelength within its bin: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
@@ -360,12 +360,12 @@ fn describe_transport(scene: &Scene) -> String {
         IntegratorKind::LightTrace => "lighttrace: light subpaths connected to the camera only (no camera paths)".into(),
         IntegratorKind::Caustics => match Caustics::new(scene, s.max_bounces, s.packet_size) {
             Some(c) => format!(
-                "caustics: auto's path tracing, except caustics of the environment and distant lights through specular surfaces: light subpaths aimed at {} specular object(s) ({:.0}% of aimed rays reach one; a light subpath for {:.1}% of the samples) connect them to the camera (no MIS: a partition of the paths)",
+                "caustics: auto's path tracing, except caustics of the environment and distant, point and spot lights through specular surfaces: light subpaths aimed at {} specular object(s) ({:.0}% of aimed rays reach one; a light subpath for {:.1}% of the samples) connect them to the camera (no MIS: a partition of the paths)",
                 c.aim.target_count(),
                 100.0 * c.aim.reach(scene),
                 100.0 * c.fraction
             ),
-            None => "caustics: no specular surface with bounds, or no environment or distant light, to aim at: auto's full-spectrum path tracing alone".into(),
+            None => "caustics: no specular surface with bounds, or no environment, distant, point or spot light, to aim at: auto's full-spectrum path tracing alone".into(),
         },
         IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
         IntegratorKind::Spectral => match s.wavelengths {

@@ -333,10 +333,8 @@ impl Bdpt {
     }
 
     /// The light subpath of `caustics`' light side: an aimed light by
-    /// [`Aim::choose_light`], its direction as [`crate::light::Light::sample_le`] draws it,
-    /// the ray's origin on the targets' disks ([`Aim::sample_origin`]); the
-    /// walk ends at its first surface vertex unless that scattered through a
-    /// delta lobe.
+    /// [`Aim::choose_light`], its ray by [`Aim::aimed_ray`]; the walk ends at
+    /// its first surface vertex unless that scattered through a delta lobe.
     fn aimed_subpath(
         &self,
         scene: &Scene,
@@ -351,13 +349,9 @@ impl Bdpt {
         let Some((index, pmf)) = aim.choose_light(u_light) else {
             return;
         };
-        let Some(e) = scene.light(index).sample_le(u_pos, u_dir) else {
+        let Some(e) = aim.aimed_ray(scene, index, u_pos, u_dir) else {
             return;
         };
-        let Some((point, pdf_pos)) = aim.sample_origin(e.dir, u_pos) else {
-            return;
-        };
-        let e = EmissionSample { point, pdf_pos, ..e };
         self.walk_from_light(scene, index, pmf, e, true, sampler, path, stacks, wl);
     }
 
