@@ -156,10 +156,21 @@ def mitsuba(xml, variant, spp, seed, out):
     return json.load(open(base + ".json"))["render_s"], base + ".exr"
 
 
-def rustv(binary, ron, spp, seed, out):
-    exr = os.path.join(out, f"r-{spp}-s{seed}.exr")
+# The sun's caustic on the floor left of the glass sphere (docs/performance.md, "Where the error is"):
+# rows 70-91, columns 0-44 at 192x128.
+CAUSTIC_ROWS, CAUSTIC_COLS = slice(70, 92), slice(0, 45)
+
+
+def box_mse(a, b):
+    """MSE within the caustic's box."""
+    return float(((load(a) - load(b))[CAUSTIC_ROWS, CAUSTIC_COLS] ** 2).mean())
+
+
+def rustv(binary, ron, spp, seed, out, integrator="auto"):
+    exr = os.path.join(out, f"r-{integrator}-{spp}-s{seed}.exr")
     r = subprocess.run([binary, "render", ron, "--spp", str(spp), "--seed", str(seed), "--width", str(W),
-                        "--height", str(H), "-o", exr], check=True, stdout=subprocess.DEVNULL,
+                        "--height", str(H), "--integrator", integrator, "-o", exr], check=True,
+                       stdout=subprocess.DEVNULL,
                        stderr=subprocess.PIPE, text=True)
     t = re.findall(r" in ([0-9.]+) s, ", r.stderr)
     return float(t[-1]), exr
@@ -258,6 +269,8 @@ def main():
     ap.add_argument("--seed0", type=int, default=1)
     ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--variant", default="llvm_ad_spectral")
+    ap.add_argument("--integrator", default="auto",
+                    help="rust-v's integrator for the timed renders (the reference is always auto's)")
     ap.add_argument("--out", default="/tmp/peer-env")
     ap.add_argument("--white-floor", action="store_true",
                     help="only the colour check: a white floor under the map, against the texels' irradiance")
@@ -289,13 +302,13 @@ def main():
         le_x = mse(li, rref)
         tot_t, tot_n = 0.0, 0
         n = 16
-        rt, ri = rustv(a.bin, ron, n, seed, a.out)
+        rt, ri = rustv(a.bin, ron, n, seed, a.out, a.integrator)
         tot_t, tot_n = tot_t + rt, tot_n + n
         re_ = mse(ri, rref)
         log(f"round {r + 1}: Mitsuba 64 spp {lt:.2f} s, MSE {le:.4g} (against rust-v's reference {le_x:.4g}); "
             f"rust-v 16 spp {rt:.2f} s MSE {re_:.4g}")
         n = max(1, math.ceil(n * re_ / le))
-        rt, ri = rustv(a.bin, ron, n, seed, a.out)
+        rt, ri = rustv(a.bin, ron, n, seed, a.out, a.integrator)
         tot_t, tot_n = tot_t + rt, tot_n + n
         re_ = mse(ri, rref)
         log(f"  rust-v {n} spp {rt:.2f} s MSE {re_:.4g}")
@@ -303,29 +316,30 @@ def main():
             guess = n
             while re_ > le and n < 4 * guess:
                 n = max(n + 1, math.ceil(n * 1.05))
-                rt, ri = rustv(a.bin, ron, n, seed, a.out)
+                rt, ri = rustv(a.bin, ron, n, seed, a.out, a.integrator)
                 tot_t, tot_n = tot_t + rt, tot_n + n
                 re_ = mse(ri, rref)
                 log(f"  rust-v {n} spp {rt:.2f} s MSE {re_:.4g}")
         else:
             while n > 1:
                 m = max(1, math.floor(n / 1.05)) if n > 20 else n - 1
-                pt, pi = rustv(a.bin, ron, m, seed, a.out)
+                pt, pi = rustv(a.bin, ron, m, seed, a.out, a.integrator)
                 tot_t, tot_n = tot_t + pt, tot_n + m
                 pe = mse(pi, rref)
                 log(f"  rust-v {m} spp {pt:.2f} s MSE {pe:.4g}")
                 if pe > le:
                     break
-                n, re_ = m, pe
+                n, re_, ri = m, pe, pi
         per = tot_t / tot_n
-        rows.append((seed, lt, le, le_x, n, n * per, re_, mse(ri, mref)))
+        rows.append((seed, lt, le, le_x, n, n * per, re_, box_mse(ri, rref), box_mse(li, mref)))
         log(f"  rust-v time to the error: {n} spp x {per:.5f} s = {n * per:.3f} s; ratio {n * per / lt:.3f}")
-    print("| round (seed) | Mitsuba 64 spp: time (s) | its MSE (own ref.) | rust-v spp | rust-v time (s) | "
-          "its MSE (own ref.) | time ratio rust-v / Mitsuba |")
-    print("|---|---|---|---|---|---|---|")
-    for seed, lt, le, le_x, n, t, re_, _ in rows:
-        print(f"| {seed} | {lt:.2f} | {le:.4g} | {n} | {t:.2f} | {re_:.4g} | {t / lt:.2f} |")
-    ratios = sorted(t / lt for _, lt, _, _, _, t, _, _ in rows)
+    print(f"rust-v: --integrator {a.integrator}\n")
+    print("| round (seed) | Mitsuba 64 spp: time (s) | its MSE (own ref.) | caustic box | rust-v spp | rust-v time (s) | "
+          "its MSE (own ref.) | caustic box | time ratio rust-v / Mitsuba |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for seed, lt, le, le_x, n, t, re_, rbox, mbox in rows:
+        print(f"| {seed} | {lt:.2f} | {le:.4g} | {mbox:.4g} | {n} | {t:.2f} | {re_:.4g} | {rbox:.4g} | {t / lt:.2f} |")
+    ratios = sorted(t / lt for _, lt, _, _, _, t, _, _, _ in rows)
     print(f"\nMedian time ratio rust-v / Mitsuba: **{ratios[len(ratios) // 2]:.2f}x**.")
     x = mse(rref, mref)
     print(f"\nThe two references against each other (model differences plus both references' noise): "

@@ -86,6 +86,8 @@ named_enum! {
         Bdpt = "bdpt",
         /// Light tracing alone: light subpaths connected to the camera.
         LightTrace = "lighttrace",
+        /// Path tracing, except for the caustics of the environment and distant, point and spot lights through specular surfaces, which light subpaths aimed at those surfaces carry to the camera.
+        Caustics = "caustics",
     }
 }
 

@@ -8,6 +8,7 @@ mod common;
 mod auto;
 mod bdpt;
 mod camera;
+mod caustics;
 mod checkpoint;
 mod cli;
 mod docs;

@@ -266,6 +266,17 @@ impl Bxdf {
         }
     }
 
+    /// True when `sample` may return a delta direction (`BsdfSample::is_delta`):
+    /// the all-delta models and a smooth Plastic's coat. A textured roughness
+    /// does not change it (a material's smoothness is decided once).
+    #[inline]
+    pub fn has_delta_lobe(&self) -> bool {
+        match self {
+            Bxdf::Plastic(p) => p.is_smooth(),
+            b => b.is_delta(),
+        }
+    }
+
     /// How the model disperses, when `sample`'s direction depends on the
     /// wavelength; `None` otherwise.
     #[inline]

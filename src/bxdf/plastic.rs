@@ -104,7 +104,7 @@ impl Plastic {
 
     /// True for a smooth coat (its reflection is a delta lobe).
     #[inline]
-    fn is_smooth(&self) -> bool {
+    pub(crate) fn is_smooth(&self) -> bool {
         self.alpha.is_nan() || self.alpha < SMOOTH_ALPHA
     }
 

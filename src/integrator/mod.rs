@@ -1,12 +1,14 @@
 //! Integrators: from a camera ray to the colour of one sample.
 //!
-//! Three light-transport methods share one spectral machinery:
+//! The light-transport methods share one spectral machinery (`bdpt` and
+//! `lighttrace`: see [`Bdpt`]):
 //!
 //! | `--integrator` | paths traced | wavelengths |
 //! |---|---|---|
 //! | `whitted` | E S* (D\|G) L: specular chains, direct light at the first diffuse hit | full spectrum, no dispersion |
 //! | `path` | all (NEE + BSDF sampling with MIS, Russian roulette) | full spectrum; a dispersive surface refracts every wavelength like 589.3 nm |
 //! | `spectral` | as `path` | a packet of `C` wavelengths (`--wavelengths hero\|random`, `--packet-size C`) that splits into single-wavelength paths at the first dispersive surface: bins, or continuous wavelengths where glass disperses (`--wavelengths continuous`: everywhere); or `--wavelengths rgb` |
+//! | `caustics` | as `path`, but the caustics of the environment and distant, point and spot lights through specular surfaces come from light subpaths aimed at those surfaces, splatted to the camera (a partition of path space, no MIS; the crate-internal `caustics` module) | as `auto` on the camera side; BDPT's one collapsed wavelength on the light side |
 //! | `auto` (default) | as `path` | the full spectrum until a path refracts at a dispersive surface (a reflection there keeps it); the refraction collapses it to `C` bins drawn in proportion to throughput × visual importance, weighted `1/(C·p)`, each refracting on its own at a continuous wavelength within its bin: no wavelength noise where nothing disperses |
 //!
 //! Every method is written once, generically over the packet size `N`
@@ -37,10 +39,12 @@
 //! verbs; none matches a light or material variant.
 
 mod bdpt;
+mod caustics;
 mod path;
 mod whitted;
 
 pub use bdpt::Bdpt;
+pub(crate) use caustics::Caustics;
 pub use path::PathTracer;
 pub use whitted::Whitted;
 
@@ -254,13 +258,22 @@ pub(crate) fn with_estimator<R>(scene: &Scene, f: impl EstimatorFn<R>) -> R {
     let bdpt = |light_only| Bdpt { max_bounces: settings.max_bounces, light_only };
     let whitted = Transport::Whitted(Whitted { max_bounces: settings.max_bounces });
     let path = |disperse| {
-        Transport::Path(PathTracer { max_bounces: settings.max_bounces, disperse, collapse_to: settings.packet_size })
+        Transport::Path(PathTracer {
+            max_bounces: settings.max_bounces,
+            disperse,
+            collapse_to: settings.packet_size,
+            light_caustics: false,
+        })
     };
     match settings.integrator {
         IntegratorKind::Auto if needs_bdpt(scene) && scene.camera.lens_system().is_none() => f.call(&bdpt(false)),
         IntegratorKind::Auto => f.call(&FullSpectrum(path(true))),
         IntegratorKind::Bdpt => f.call(&bdpt(false)),
         IntegratorKind::LightTrace => f.call(&bdpt(true)),
+        IntegratorKind::Caustics => match Caustics::new(scene, settings.max_bounces, settings.packet_size) {
+            Some(c) => f.call(&c),
+            None => f.call(&FullSpectrum(path(true))),
+        },
         IntegratorKind::Whitted => f.call(&FullSpectrum(whitted)),
         IntegratorKind::Path => f.call(&FullSpectrum(path(false))),
         IntegratorKind::Spectral => {
@@ -345,6 +358,15 @@ fn describe_transport(scene: &Scene) -> String {
         IntegratorKind::Path => "path: full-spectrum path tracing".into(),
         IntegratorKind::Bdpt => "bdpt: bidirectional path tracing, every strategy combined by MIS (power heuristic)".into(),
         IntegratorKind::LightTrace => "lighttrace: light subpaths connected to the camera only (no camera paths)".into(),
+        IntegratorKind::Caustics => match Caustics::new(scene, s.max_bounces, s.packet_size) {
+            Some(c) => format!(
+                "caustics: auto's path tracing, except caustics of the environment and distant, point and spot lights through specular surfaces: light subpaths aimed at {} specular object(s) ({:.0}% of aimed rays reach one; a light subpath for {:.1}% of the samples) connect them to the camera (no MIS: a partition of the paths)",
+                c.aim.target_count(),
+                100.0 * c.aim.reach(scene),
+                100.0 * c.fraction
+            ),
+            None => "caustics: no specular surface with bounds, or no environment, distant, point or spot light, to aim at: auto's full-spectrum path tracing alone".into(),
+        },
         IntegratorKind::Whitted => "whitted: specular chains and direct light at the first diffuse hit (no indirect light, no caustics)".into(),
         IntegratorKind::Spectral => match s.wavelengths {
             WavelengthsKind::Rgb => "spectral, rgb: three wavelengths (435.8, 546.1, 700 nm) read out as RGB".into(),

@@ -76,6 +76,12 @@ pub struct PathTracer {
     /// refracts at a dispersive surface (`auto`); packets smaller than the
     /// full spectrum split into all their wavelengths.
     pub collapse_to: u32,
+    /// `--integrator caustics`' camera side: an escape to the environment
+    /// through a delta lobe, on a path whose first vertex scattered through a
+    /// non-delta lobe, adds nothing (light subpaths aimed at the specular
+    /// surfaces carry those paths: `super::caustics`). False for every
+    /// other integrator.
+    pub light_caustics: bool,
 }
 
 /// What the walk remembers about the previous vertex, for MIS at emitters.
@@ -96,6 +102,10 @@ struct Walk<const N: usize> {
     prev: Prev,
     /// The dielectric media the path is inside.
     media: VolumeStack,
+    /// The light side of `caustics` owns this path's escapes through a delta
+    /// lobe: [`PathTracer::light_caustics`] is set and the first vertex
+    /// scattered through a non-delta lobe.
+    owned: bool,
 }
 
 impl PathTracer {
@@ -122,6 +132,7 @@ impl PathTracer {
             bounces: 0,
             prev: Prev { p: ray.origin, pdf_bsdf: 0.0, delta: true },
             media: scene.camera_volumes,
+            owned: false,
         };
         self.walk(scene, ray, si, walk, lambdas, sampler, Start::Camera)
     }
@@ -282,6 +293,9 @@ impl PathTracer {
             at.scattered(&mut w.media, ray.dir, hit.n, wi);
             w.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
             w.eta_scale *= bs.eta * bs.eta;
+            if w.bounces == 0 {
+                w.owned = self.light_caustics && !bs.is_delta;
+            }
             w.bounces += 1;
             w.prev = Prev { p: hit.p, pdf_bsdf: bs.pdf, delta: bs.is_delta };
             if w.beta.is_black() {
@@ -452,9 +466,14 @@ impl PathTracer {
 /// The environment's radiance for a walk whose ray escaped the scene,
 /// MIS-weighted against the light sample taken at the previous vertex (zero
 /// without an environment, or when the path is inside an absorbing medium:
-/// an infinite segment there transmits nothing).
+/// an infinite segment there transmits nothing; zero too for a path `caustics`'
+/// light side owns, [`Walk::owned`], that escapes through a delta lobe).
 #[inline]
 fn escape<const N: usize>(scene: &Scene, ray: &Ray, w: &Walk<N>, lambdas: &Lambdas<N>) -> Sampled<N> {
+    if w.owned && w.prev.delta {
+        // `caustics`: the light side's path (see `Walk::owned`).
+        return Sampled::splat(0.0);
+    }
     match scene.escaped(ray.dir) {
         Some((light, le)) if scene.medium_in(w.media.current()).is_none() => {
             let weight =
@@ -503,5 +522,12 @@ fn beta_at<const N: usize>(beta: &Sampled<N>, one: &Lambdas<1>) -> f32 {
 /// The packet-independent part of a walk's state, for a split.
 #[inline]
 fn copy_walk<const N: usize>(w: &Walk<N>) -> Walk<1> {
-    Walk { beta: Sampled([0.0]), eta_scale: w.eta_scale, bounces: w.bounces, prev: w.prev, media: w.media }
+    Walk {
+        beta: Sampled([0.0]),
+        eta_scale: w.eta_scale,
+        bounces: w.bounces,
+        prev: w.prev,
+        media: w.media,
+        owned: w.owned,
+    }
 }

@@ -325,6 +325,15 @@ fn build(ctx: &Check<'_>, desc: SceneDesc, overrides: &SettingsPatch) -> Result<
         let field = if i < desc.objects.len() { format!("objects[{i}].interior") } else { "camera.medium".into() };
         return Err(ctx.err(field, "a Grid medium: whitted does not track media; use auto, path or spectral"));
     }
+    if let Some(i) = objects.iter().position(|o| o.interior.as_ref().is_some_and(|m| m.scatters() || m.is_grid()))
+        && settings.integrator == IntegratorKind::Caustics
+    {
+        let field = if i < desc.objects.len() { format!("objects[{i}].interior") } else { "camera.medium".into() };
+        return Err(ctx.err(
+            field,
+            "--integrator caustics: scenes with media are not supported yet (an absorbing dielectric is); use bdpt",
+        ));
+    }
 
     let c = &desc.camera;
     let eye = ctx.vec("camera.eye", c.eye)?;
@@ -579,6 +588,12 @@ fn lens_camera(
         if given {
             return Err(ctx.err(field, "not with a `lens`: the lens's own fields set the view, aperture and focus"));
         }
+    }
+    if settings.integrator == IntegratorKind::Caustics {
+        return Err(ctx.err(
+            "camera.lens",
+            "caustics splats light subpaths to the camera, which needs the camera's importance, which a lens system does not define; use auto, path, spectral or whitted",
+        ));
     }
     if matches!(settings.integrator, IntegratorKind::Bdpt | IntegratorKind::LightTrace) {
         return Err(ctx.err(

@@ -236,6 +236,37 @@ impl Scene {
         })
     }
 
+    /// The bounding spheres `(centre, radius)` of the objects that may scatter
+    /// through a delta lobe ([`Bxdf::has_delta_lobe`] of any material a hit on
+    /// them may have; an index-matched `Interface` does not count, as in
+    /// [`Scene::has_delta_surface`]): where `--integrator caustics` aims its
+    /// light subpaths. Instances and meshes by their world bounds. `None`
+    /// when such an object is unbounded (no sphere holds it).
+    pub fn delta_targets(&self) -> Option<Vec<(Vec3, f32)>> {
+        let mut targets = Vec::new();
+        for (i, o) in self.objects.iter().enumerate() {
+            if self.may_scatter_delta(i as u32) {
+                // A sphere is its own bounding sphere (its box's is √3 times as wide).
+                if let crate::shape::Shape::Sphere(s) = &o.shape {
+                    targets.push((s.center, s.radius));
+                } else {
+                    let b = o.shape.bounds()?;
+                    targets.push((b.centroid(), b.diagonal().length() * 0.5));
+                }
+            }
+        }
+        Some(targets)
+    }
+
+    /// True when a hit on object `object` may scatter through a delta lobe
+    /// ([`Bxdf::has_delta_lobe`] of any material it may have; not an `Interface`).
+    pub fn may_scatter_delta(&self, object: u32) -> bool {
+        self.leaves(&self.objects[object as usize].material).iter().any(|&m| {
+            let m = &self.materials[m as usize];
+            m.has_delta_lobe() && !m.is_interface()
+        })
+    }
+
     /// The emission leaving surface hit `si` back along `dir` (the direction
     /// the ray travelled), or `None` where nothing leaves that side. A
     /// textured emitter's radiance at the hit's (u, v) is built in `slot`,

@@ -25,7 +25,7 @@ use crate::common::{mean_and_stderr, render_str, temp_dir};
 /// (`lighttrace`) cannot connect a specular vertex to the eye: each row says
 /// what it must give (the answer on diffuse surfaces, 0 through smooth glass
 /// or in a mirror); `lighttrace.rs` holds its rows that need more samples.
-const METHODS: [&str; 7] = ["whitted", "path", "hero", "random", "auto", "bdpt", "lighttrace"];
+const METHODS: [&str; 8] = ["whitted", "path", "hero", "random", "auto", "bdpt", "lighttrace", "caustics"];
 
 fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
     let (integrator, wavelengths) = match m {
@@ -36,6 +36,7 @@ fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
         "auto" => (IntegratorKind::Auto, None),
         "bdpt" => (IntegratorKind::Bdpt, None),
         "lighttrace" => (IntegratorKind::LightTrace, None),
+        "caustics" => (IntegratorKind::Caustics, None),
         _ => unreachable!(),
     };
     SettingsPatch { integrator: Some(integrator), wavelengths, spp: Some(spp), seed: Some(seed), ..Default::default() }
@@ -44,7 +45,7 @@ fn method(m: &str, spp: u32, seed: u64) -> SettingsPatch {
 /// Full-spectrum methods give every sample the same colour for a grey
 /// scene; the packet samplers (hero, random) add colour noise with the right mean.
 fn full_spectrum(m: &str) -> bool {
-    matches!(m, "whitted" | "path" | "auto" | "bdpt" | "lighttrace")
+    matches!(m, "whitted" | "path" | "auto" | "bdpt" | "lighttrace" | "caustics")
 }
 
 /// Relative per-pixel tolerance where every path of a full-spectrum method
@@ -56,7 +57,7 @@ fn full_spectrum(m: &str) -> bool {
 /// where the answer is uniform (a light subpath's splat lands in one pixel):
 /// 10%.
 fn pixel_tol(m: &str) -> f64 {
-    if m == "bdpt" || m == "lighttrace" { 0.1 } else { 0.01 }
+    if matches!(m, "bdpt" | "lighttrace" | "caustics") { 0.1 } else { 0.01 }
 }
 
 /// Per-pixel Y.

@@ -106,7 +106,9 @@ use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::{Contribution, Lambdas};
 
+use super::caustics::Aim;
 use super::{Estimator, camera_ray};
+use crate::light::EmissionSample;
 use vertex::{Contrib, Kind, Vertex, Wavelength};
 use walk::Walk;
 
@@ -243,6 +245,51 @@ impl Estimator for Bdpt {
 }
 
 impl Bdpt {
+    /// `caustics`' light side for one camera sample: one aimed light subpath
+    /// (its wavelength draw `u_λ` from [`Dim::wavelength`]`(1)`, which the
+    /// camera side never draws), and, when its first surface vertex
+    /// scattered through a delta lobe, every later vertex `y_i`, `i ≥ 2`,
+    /// connected to the eye (`t = 1`, weight 1, as `lighttrace`'s: `self`
+    /// is `light_only`) and splatted to `splats`, scaled by `weight`.
+    pub(crate) fn caustic_splats<O: Contribution>(
+        &self,
+        scene: &Scene,
+        aim: &Aim,
+        sampler: &mut Sampler,
+        splats: &mut Vec<Splat<O>>,
+        weight: f32,
+    ) {
+        debug_assert!(self.light_only, "caustics' light side is unweighted");
+        PATHS.with(|paths| {
+            let mut paths = paths.borrow_mut();
+            let Paths { camera, light, camera_media, light_media } = &mut *paths;
+            camera.clear();
+            light.clear();
+            camera_media.clear();
+            light_media.clear();
+            let track = scene.has_volumes();
+            let mut wl = Wavelength { u: sampler.get_1d(Dim::wavelength(1)), continuous: O::CONTINUOUS, drawn: None };
+            self.aimed_subpath(scene, aim, sampler, light, track.then_some(&mut *light_media), &mut wl);
+            if light.len() < 3 || !light[1].delta {
+                return;
+            }
+            let full = Lambdas::full();
+            let max = self.max_bounces as usize;
+            let (camera, light) = (Sub { v: camera, media: camera_media }, Sub { v: light, media: light_media });
+            for s in 3..=light.v.len().min(max + 1) {
+                if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, sampler, &mut wl) {
+                    let value = match c {
+                        Contrib::Full(c) => O::from_packet(&scene.sensor, &full, &(c * weight)),
+                        Contrib::Single(v) => {
+                            O::from_packet(&scene.sensor, &wl.single().lambdas, &Sampled([v * weight]))
+                        }
+                    };
+                    splats.push(Splat { x: pixel.x as u32, y: pixel.y as u32, value });
+                }
+            }
+        })
+    }
+
     /// The eye and the walk of the pixel ray.
     fn camera_subpath(
         &self,
@@ -260,7 +307,7 @@ impl Bdpt {
             stacks.push(scene.camera_volumes);
         }
         let pdf_dir = cam.pdf_dir_from(ray.origin, ray.dir);
-        let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2 };
+        let walk = Walk { importance: false, max_vertices: self.max_bounces as usize + 2, delta_first: false };
         walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_volumes, wl);
     }
 
@@ -270,7 +317,7 @@ impl Bdpt {
         scene: &Scene,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
-        mut stacks: Option<&mut Vec<VolumeStack>>,
+        stacks: Option<&mut Vec<VolumeStack>>,
         wl: &mut Wavelength,
     ) {
         let u_light = sampler.get_1d_if(scene.light_count() > 1, Dim::EMIT_CHOICE);
@@ -282,16 +329,58 @@ impl Bdpt {
         let Some(e) = light.sample_le(u_pos, u_dir) else {
             return;
         };
+        self.walk_from_light(scene, index as u32, pmf, e, false, sampler, path, stacks, wl);
+    }
+
+    /// The light subpath of `caustics`' light side: an aimed light by
+    /// [`Aim::choose_light`], its ray by [`Aim::aimed_ray`]; the walk ends at
+    /// its first surface vertex unless that scattered through a delta lobe.
+    fn aimed_subpath(
+        &self,
+        scene: &Scene,
+        aim: &Aim,
+        sampler: &mut Sampler,
+        path: &mut Vec<Vertex>,
+        stacks: Option<&mut Vec<VolumeStack>>,
+        wl: &mut Wavelength,
+    ) {
+        let u_light = sampler.get_1d_if(aim.light_count() > 1, Dim::EMIT_CHOICE);
+        let (u_pos, u_dir) = (sampler.get_2d(Dim::EMIT_POSITION), sampler.get_2d(Dim::EMIT_DIRECTION));
+        let Some((index, pmf)) = aim.choose_light(u_light) else {
+            return;
+        };
+        let Some(e) = aim.aimed_ray(scene, index, u_pos, u_dir) else {
+            return;
+        };
+        self.walk_from_light(scene, index, pmf, e, true, sampler, path, stacks, wl);
+    }
+
+    /// The light vertex of ray `e` leaving light `index` (chosen with
+    /// probability `pmf`) and the subpath's walk from it.
+    #[allow(clippy::too_many_arguments)]
+    fn walk_from_light(
+        &self,
+        scene: &Scene,
+        index: u32,
+        pmf: f32,
+        e: EmissionSample,
+        delta_first: bool,
+        sampler: &mut Sampler,
+        path: &mut Vec<Vertex>,
+        mut stacks: Option<&mut Vec<VolumeStack>>,
+        wl: &mut Wavelength,
+    ) {
+        let light = scene.light(index);
         let pdf_origin = pmf * e.pdf_pos;
         if !(pdf_origin > 0.0 && e.pdf_dir > 0.0) {
             return;
         }
         let infinite = light.is_infinite();
-        let beta0 = scene.with_radiance(index as u32, -e.dir, e.uv, |s| *s / pdf_origin);
+        let beta0 = scene.with_radiance(index, -e.dir, e.uv, |s| *s / pdf_origin);
         // The environment's first vertex is a direction: its density is the
         // direction's (per solid angle), as a camera subpath escaping along it sees it.
         let pdf_y0 = if infinite { pmf * e.pdf_dir } else { pdf_origin };
-        path.push(Vertex::at_point(Kind::Light(index as u32), e.point, e.n, beta0, pdf_y0));
+        path.push(Vertex::at_point(Kind::Light(index), e.point, e.n, beta0, pdf_y0));
         let media = scene.volumes_at(e.point);
         if let Some(stacks) = stacks.as_deref_mut() {
             stacks.push(media);
@@ -303,7 +392,7 @@ impl Bdpt {
         let (pdf, parallel) =
             if light.is_delta_direction() || infinite { (e.pdf_pos, true) } else { (e.pdf_dir, false) };
         let ray = Ray::spawn(e.point, e.n, e.dir);
-        let walk = Walk { importance: true, max_vertices: self.max_bounces as usize + 1 };
+        let walk = Walk { importance: true, max_vertices: self.max_bounces as usize + 1, delta_first };
         walk.run(scene, ray, beta, pdf, parallel, sampler, path, stacks, media, wl);
     }
 }

@@ -18,6 +18,9 @@ pub(super) struct Walk {
     pub(super) importance: bool,
     /// The most vertices the subpath may have, its first included.
     pub(super) max_vertices: usize,
+    /// End the subpath at its first surface vertex unless that vertex
+    /// scattered through a delta lobe (`caustics`' light side).
+    pub(super) delta_first: bool,
 }
 
 impl Walk {
@@ -228,6 +231,9 @@ impl Walk {
             let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf_within(bs.wi, sh.wo, &full, out)) };
             let n = path.len();
             path[n - 1].delta = bs.is_delta;
+            if self.delta_first && n == 2 && !bs.is_delta {
+                break;
+            }
             path[n - 2].pdf_rev = rev * path[n - 1].g_prev;
             pdf_dir = fwd;
             if beta.is_black() {

@@ -46,6 +46,7 @@ enum Integrator {
     path,
     bdpt,
     lighttrace,
+    caustics,
     whitted,
     spectral,
 }
@@ -104,6 +105,7 @@ fn render(p: &SettingsPatch) -> Render {
             IntegratorKind::Path => Integrator::path,
             IntegratorKind::Bdpt => Integrator::bdpt,
             IntegratorKind::LightTrace => Integrator::lighttrace,
+            IntegratorKind::Caustics => Integrator::caustics,
             IntegratorKind::Whitted => Integrator::whitted,
             IntegratorKind::Spectral => Integrator::spectral,
         }),

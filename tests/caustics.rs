@@ -1,0 +1,272 @@
+//! `--integrator caustics` (issue 35): path tracing plus aimed light
+//! subpaths for the caustics of the environment and distant lights through
+//! specular surfaces. Checked against the other integrators' converged
+//! means (independent estimators of the same image), for bit-identity
+//! with `path` where there is nothing to aim, and for determinism.
+
+use std::sync::atomic::AtomicBool;
+
+use rust_v::film::Film;
+use rust_v::render::{Limits, render};
+use rust_v::scene::load_scene_str;
+use rust_v::settings::{IntegratorKind, SettingsPatch};
+
+use crate::common::{block_means, render_str, root};
+
+fn settings(integrator: IntegratorKind, size: u32, spp: u32, seed: u64) -> SettingsPatch {
+    SettingsPatch {
+        integrator: Some(integrator),
+        width: Some(size),
+        height: Some(size),
+        spp: Some(spp),
+        seed: Some(seed),
+        ..Default::default()
+    }
+}
+
+/// Per 4x4 block: the mean over `seeds` renders and its standard error from
+/// the seeds' spread (a light subpath splats anywhere, so the seeds, not
+/// the pixels, give the error).
+fn seeded_blocks(text: &str, integrator: IntegratorKind, size: u32, spp: u32, seeds: u64) -> Vec<(f64, f64)> {
+    let runs: Vec<Vec<f64>> =
+        (0..seeds).map(|s| block_means(&render_str(text, &settings(integrator, size, spp, 100 + s)), 4)).collect();
+    let n = seeds as f64;
+    (0..runs[0].len())
+        .map(|k| {
+            let v: Vec<f64> = runs.iter().map(|r| r[k]).collect();
+            let m = v.iter().sum::<f64>() / n;
+            let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+            (m, (var / n).sqrt())
+        })
+        .collect()
+}
+
+/// Asserts every block of `a` within 4.5 combined standard errors (+1e-4)
+/// of `b`'s (16 blocks: all pass by chance with probability > 99.9%), and
+/// the image means (mean of the blocks, errors in quadrature: an upper
+/// bound for independent blocks) within 4.5 combined s.e. too.
+fn assert_blocks_agree(what: &str, a: &[(f64, f64)], b: &[(f64, f64)]) {
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        let se = (x.1 * x.1 + y.1 * y.1).sqrt();
+        assert!((x.0 - y.0).abs() <= 4.5 * se + 1e-4, "{what}, block {k}: {:.4} vs {:.4} (se {se:.4})", x.0, y.0);
+    }
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().map(|x| x.0).sum::<f64>() / n, b.iter().map(|x| x.0).sum::<f64>() / n);
+    let se = (a.iter().chain(b).map(|x| x.1 * x.1).sum::<f64>()).sqrt() / n;
+    eprintln!(
+        "{what}: image {ma:.4} vs {mb:.4}, differ {:+.2}%, s.e. {:.2}%",
+        100.0 * (ma / mb - 1.0),
+        100.0 * se / mb
+    );
+    assert!((ma - mb).abs() <= 4.5 * se + 1e-5, "{what}: image {ma} vs {mb} (se {se})");
+}
+
+/// A smooth glass sphere over a diffuse floor (its focus, 1.5 radii from
+/// its centre for an index of 1.5, on the floor), lit by `light` (a RON line).
+fn glass_over_floor(light: &str) -> String {
+    format!(
+        r#"(
+        camera: (eye: (0, 1.3, 2.6), look_at: (0, 0.25, 0), fov_deg: 45),
+        render: (max_bounces: 8),
+        materials: {{ "glass": Dielectric(ior: Constant(1.5)), "floor": Lambertian(reflectance: Constant(0.7)) }},
+        objects: [
+            (shape: Quad(origin: (-3, 0, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor"),
+            (shape: Sphere(center: (0, 0.75, 0), radius: 0.5), material: "glass"),
+        ],
+        {light}
+    )"#
+    )
+}
+
+/// Under a uniform environment the two sides of the partition add up to
+/// path tracing's image: every 4x4 block of 24 `caustics` renders agrees
+/// with 24 `path` renders (16x16, 16 spp each), the floor under and around
+/// the sphere (where the light side's paths land) included.
+#[test]
+fn caustics_matches_path_under_a_uniform_environment() {
+    let text = glass_over_floor("environment: Uniform(Constant(1)),");
+    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24);
+    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+    assert_blocks_agree("uniform environment, caustics vs path", &caustics, &path);
+}
+
+/// Under the sky with its sun (half a degree: path tracing finds its caustic
+/// only by hitting it through the glass), `caustics` agrees with BDPT block
+/// by block (24 renders each, 16x16, 16 spp).
+#[test]
+fn caustics_matches_bdpt_under_the_sky_with_its_sun() {
+    let text = glass_over_floor(
+        "environment: Sky(sun_elevation_deg: 50, sun_azimuth_deg: 20, turbidity: 3, ground_albedo: 0.3, scale: 0.05),",
+    );
+    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
+    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+    assert_blocks_agree("sky with sun, caustics vs bdpt", &caustics, &bdpt);
+}
+
+/// A distant light over the glass sphere: path tracing cannot see its
+/// caustic (no camera path hits a delta light), `caustics` and BDPT do.
+/// Every block of `caustics` agrees with BDPT's; the block where BDPT
+/// exceeds path tracing most (the caustic) is brighter than path tracing's
+/// by more than 10 combined standard errors, and `caustics` has it too.
+#[test]
+fn a_distant_lights_caustic_that_path_tracing_misses() {
+    let text = glass_over_floor("lights: [ Distant(direction: (0.25, -1, -0.3), irradiance: Constant(3)) ],");
+    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
+    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24);
+    assert_blocks_agree("distant light, caustics vs bdpt", &caustics, &bdpt);
+    let (k, gap) =
+        bdpt.iter().zip(&path).map(|(b, p)| b.0 - p.0).enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
+    let se = |a: &(f64, f64), b: &(f64, f64)| (a.1 * a.1 + b.1 * b.1).sqrt();
+    eprintln!("caustic block {k}: bdpt {:.4}, caustics {:.4}, path {:.4}", bdpt[k].0, caustics[k].0, path[k].0);
+    assert!(gap > 10.0 * se(&bdpt[k], &path[k]), "no caustic that path misses: {gap}");
+    assert!(caustics[k].0 - path[k].0 > 10.0 * se(&caustics[k], &path[k]), "caustics misses the caustic");
+}
+
+/// A point light and a spot light over the glass sphere: their caustics
+/// (which path tracing cannot see) come from light subpaths aimed by the
+/// cone mixture; every block agrees with BDPT's, the caustic's included.
+#[test]
+fn point_and_spot_light_caustics_match_bdpt() {
+    for light in [
+        "lights: [ Point(position: (0.3, 2.2, 0.2), intensity: Constant(4)) ],",
+        "lights: [ Spot(position: (0.3, 2.2, 0.2), look_at: (0, 0, 0), cone_deg: 30, falloff_deg: 10, intensity: Constant(4)) ],",
+    ] {
+        let text = glass_over_floor(light);
+        let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
+        let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+        assert_blocks_agree(&format!("{light} caustics vs bdpt"), &caustics, &bdpt);
+    }
+}
+
+/// A wall with a hole between a distant light and the glass sphere: most
+/// aimed rays hit the wall, so a light subpath is traced for more of the
+/// samples (and weighted less); `caustics` still agrees with BDPT block by
+/// block, the caustic through the hole included.
+#[test]
+fn a_blocked_target_raises_the_rate_and_stays_unbiased() {
+    let text = r#"(
+        camera: (eye: (0, 1.3, 2.6), look_at: (0, 0.25, 0), fov_deg: 45),
+        render: (max_bounces: 8),
+        materials: { "glass": Dielectric(ior: Constant(1.5)), "floor": Lambertian(reflectance: Constant(0.7)) },
+        objects: [
+            (shape: Quad(origin: (-3, 0, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor"),
+            (shape: Sphere(center: (0, 0.75, 0), radius: 0.5), material: "glass"),
+            // A roof at y = 1.6 over the sphere, open over x in (-0.25, 0.25).
+            (shape: Quad(origin: (-1, 1.6, -1), edge_u: (0.75, 0, 0), edge_v: (0, 0, 2)), material: "floor"),
+            (shape: Quad(origin: (0.25, 1.6, -1), edge_u: (0.75, 0, 0), edge_v: (0, 0, 2)), material: "floor"),
+        ],
+        lights: [ Distant(direction: (0, -1, 0), irradiance: Constant(3)) ],
+    )"#;
+    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 16, 24);
+    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24);
+    assert_blocks_agree("a roof with a slot, caustics vs bdpt", &caustics, &bdpt);
+}
+
+/// The camera inside a large glass sphere (a target that encloses the eye)
+/// around a small glass sphere on a floor, under a uniform environment:
+/// camera paths start inside the glass, light subpaths pass its surface
+/// (and totally reflect inside it at grazing angles); `caustics` agrees
+/// with `path` block by block.
+#[test]
+fn a_target_that_encloses_the_camera() {
+    let text = r#"(
+        camera: (eye: (0, 1.3, 2.6), look_at: (0, 0.25, 0), fov_deg: 45),
+        render: (max_bounces: 8),
+        materials: { "glass": Dielectric(ior: Constant(1.5)), "dome": Dielectric(ior: Constant(1.2)),
+                     "floor": Lambertian(reflectance: Constant(0.7)) },
+        objects: [
+            (shape: Quad(origin: (-2, 0, 3), edge_u: (4, 0, 0), edge_v: (0, 0, -5)), material: "floor"),
+            (shape: Sphere(center: (0, 0.5, 0), radius: 0.5), material: "glass"),
+            (shape: Sphere(center: (0, 0.5, 0.5), radius: 4), material: "dome"),
+        ],
+        environment: Uniform(Constant(1)),
+    )"#;
+    let path = seeded_blocks(text, IntegratorKind::Path, 16, 16, 24);
+    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24);
+    assert_blocks_agree("camera inside a glass dome, caustics vs path", &caustics, &path);
+}
+
+/// With nothing to aim at (no specular surface, or no environment or
+/// distant light) `caustics` is path tracing: bit-identical images.
+#[test]
+fn nothing_to_aim_at_renders_as_path() {
+    let diffuse = r#"(
+        camera: (eye: (0, 1.3, 2.6), look_at: (0, 0.25, 0), fov_deg: 45),
+        materials: { "clay": Lambertian(reflectance: Constant(0.5)), "floor": Lambertian(reflectance: Constant(0.7)) },
+        objects: [
+            (shape: Quad(origin: (-3, 0, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor"),
+            (shape: Sphere(center: (0, 0.5, 0), radius: 0.5), material: "clay"),
+        ],
+        environment: Uniform(Constant(1)),
+    )"#;
+    let area_light = r#"(
+        camera: (eye: (0, 1.3, 2.6), look_at: (0, 0.25, 0), fov_deg: 45),
+        materials: { "glass": Dielectric(ior: Constant(1.5)), "floor": Lambertian(reflectance: Constant(0.7)) },
+        objects: [
+            (shape: Quad(origin: (-3, 0, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor"),
+            (shape: Sphere(center: (0, 0.5, 0), radius: 0.5), material: "glass"),
+            (shape: Sphere(center: (0.5, 2, 0), radius: 0.3), emission: Constant(4)),
+        ],
+    )"#;
+    for (what, text) in [("no specular surface", diffuse.to_string()), ("only an area light", area_light.to_string())] {
+        let path = render_str(&text, &settings(IntegratorKind::Path, 16, 4, 3));
+        let caustics = render_str(&text, &settings(IntegratorKind::Caustics, 16, 4, 3));
+        assert!(path.mean_xyz().iter().any(|p| p[1] > 0.0), "{what}: black");
+        assert_eq!(caustics, path, "{what}");
+    }
+}
+
+fn render_into(scene: &rust_v::scene::Scene, film: &mut Film, passes: std::ops::Range<u32>) {
+    let stop = AtomicBool::new(false);
+    let stats = render(scene, film, passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
+    assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
+}
+
+/// Splats keep every guarantee: the image is bit-identical for 1 and 2
+/// threads, and passes 0..6 equal merge(0..3, 3..6).
+#[test]
+fn caustics_is_deterministic_and_merges_exactly() {
+    let text = glass_over_floor("lights: [ Distant(direction: (0.25, -1, -0.3), irradiance: Constant(3)) ],");
+    let scene = load_scene_str(&text, &root().join("t.ron"), &settings(IntegratorKind::Caustics, 24, 6, 5)).unwrap();
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let whole = |pool: &rayon::ThreadPool| {
+        pool.install(|| {
+            let mut f = Film::new(24, 24);
+            render_into(&scene, &mut f, 0..6);
+            f
+        })
+    };
+    let (whole1, whole2) = (whole(&one), whole(&two));
+    assert_eq!(whole1, whole2, "1 vs 2 threads");
+    let mut a = Film::new(24, 24);
+    render_into(&scene, &mut a, 0..3);
+    let mut b = Film::starting_at(24, 24, 3);
+    render_into(&scene, &mut b, 3..6);
+    a.merge(&b).unwrap();
+    assert_eq!(a, whole1, "merged halves");
+    // The light side splatted something: the image differs from path tracing's.
+    let path = load_scene_str(&text, &root().join("t.ron"), &settings(IntegratorKind::Path, 24, 6, 5)).unwrap();
+    let mut p = Film::new(24, 24);
+    render_into(&path, &mut p, 0..6);
+    assert_ne!(p, whole1);
+}
+
+/// A scattering medium is refused with the field and what to use instead.
+#[test]
+fn scattering_media_are_refused() {
+    let text = r#"(
+        camera: (eye: (0, 0, 4), look_at: (0, 0, 0), fov_deg: 40),
+        media: { "fog": Homogeneous(sigma_a: Constant(0.1), sigma_s: Constant(1)) },
+        materials: { "glass": Dielectric(ior: Constant(1.5)) },
+        objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass", interior: "fog") ],
+        environment: Uniform(Constant(1)),
+    )"#;
+    let Err(e) = load_scene_str(text, &root().join("t.ron"), &settings(IntegratorKind::Caustics, 8, 1, 1)) else {
+        panic!("a scattering medium loads with caustics");
+    };
+    let msg = e.to_string();
+    assert!(msg.contains("objects[0].interior") && msg.contains("caustics") && msg.contains("bdpt"), "{msg}");
+    assert!(load_scene_str(text, &root().join("t.ron"), &settings(IntegratorKind::Bdpt, 8, 1, 1)).is_ok());
+}
