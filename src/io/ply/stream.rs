@@ -150,7 +150,7 @@ impl Scan {
                 }
             }
             if n > 0 {
-                out.push((self.chunks, Chunk { ei: self.ei, range: start..offset, first_line }));
+                out.push((self.chunks, Chunk { ei: self.ei, range: start..offset, first_line, lines: n }));
                 self.chunks += 1;
             }
             self.remaining -= n;
