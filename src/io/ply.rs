@@ -315,22 +315,19 @@ impl Ascii<'_> {
     /// element each, in file order; `None` when the file ends early.
     fn chunks(&self, chunk_lines: usize) -> Option<Vec<Chunk>> {
         let mut chunks = Vec::new();
-        let mut pieces = self.text.split_inclusive('\n');
         let (mut offset, mut ln) = (0usize, self.header_lines);
         for (ei, el) in self.elements.iter().enumerate() {
             let mut remaining = el.count;
             while remaining > 0 {
-                let (start, first_line) = (offset, ln + 1);
-                let mut n = 0;
-                while n < remaining.min(chunk_lines) {
-                    let piece = pieces.next()?;
-                    ln += 1;
-                    offset += piece.len();
-                    if !piece.trim().is_empty() {
-                        n += 1;
-                    }
+                let want = remaining.min(chunk_lines);
+                let (bytes, lines, n) = ascii::take_lines(&self.text[offset..], want);
+                if n < want {
+                    return None;
                 }
-                chunks.push(Chunk { ei, range: start..offset, first_line, lines: n });
+                let start = offset;
+                offset += bytes;
+                chunks.push(Chunk { ei, range: start..offset, first_line: ln + 1, lines: n });
+                ln += lines;
                 remaining -= n;
             }
         }

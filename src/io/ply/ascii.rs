@@ -104,6 +104,41 @@ impl Bytes<'_> {
     }
 }
 
+/// Bytes looked at at once by [`take_lines`].
+const SCAN_BLOCK: usize = 4096;
+
+/// The first `want` non-blank lines of `text` (lines end after `\n`; blank:
+/// empty after `str::trim`) and any blank lines among them: the bytes and the
+/// lines taken and how many were not blank, fewer than `want` where the text
+/// ends first. What `text.split_inclusive('\n')` gives piece by piece, but
+/// [`SCAN_BLOCK`] bytes at a time where every line in them starts with a
+/// visible ASCII byte (none is blank): their line ends are then counted in a
+/// loop the compiler vectorizes.
+pub(super) fn take_lines(text: &str, want: usize) -> (usize, usize, usize) {
+    let b = text.as_bytes();
+    let (mut pos, mut lines, mut n) = (0, 0, 0);
+    while n < want && pos < b.len() {
+        if b[pos].is_ascii_graphic() && pos + SCAN_BLOCK < b.len() {
+            let block = &b[pos..pos + SCAN_BLOCK];
+            let ends = block.iter().fold(0usize, |c, &x| c + usize::from(x == b'\n'));
+            let blank_next = block
+                .iter()
+                .zip(&b[pos + 1..])
+                .fold(0usize, |c, (&x, y)| c + usize::from(x == b'\n' && !y.is_ascii_graphic()));
+            if ends > 0 && blank_next == 0 && n + ends <= want {
+                pos += block.iter().rposition(|&x| x == b'\n').map_or(0, |i| i + 1);
+                (lines, n) = (lines + ends, n + ends);
+                continue;
+            }
+        }
+        let end = text[pos..].find('\n').map_or(b.len(), |i| pos + i + 1);
+        lines += 1;
+        n += usize::from(!text[pos..end].trim().is_empty());
+        pos = end;
+    }
+    (pos, lines, n)
+}
+
 /// The plain decimal number that starts at `b[start]` (see the module's
 /// notes) and where it ends; `None` when the token there is anything else or
 /// outside Clinger's fast path.
@@ -365,6 +400,52 @@ mod tests {
         }
         assert!(toks.len() > 1_000_000, "{}", toks.len());
         assert!(plain > 300_000 && fast == plain, "{fast} of {plain} plain short tokens took the fast path");
+    }
+
+    /// [`take_lines`] against `split_inclusive('\n')` piece by piece (the
+    /// scan it replaces), taking a text in runs of `want` non-blank lines to
+    /// its end, on random texts: mostly number lines (runs longer than
+    /// [`SCAN_BLOCK`] bytes with no blank line), some blank lines of spaces,
+    /// tabs, `\r`, a vertical tab or a no-break space, lines starting with
+    /// blanks, lines longer than a block, with or without a last line end.
+    #[test]
+    fn take_lines_counts_as_split_inclusive() {
+        fn reference(text: &str, want: usize) -> (usize, usize, usize) {
+            let (mut bytes, mut lines, mut n) = (0, 0, 0);
+            for piece in text.split_inclusive('\n') {
+                if n == want {
+                    break;
+                }
+                (bytes, lines) = (bytes + piece.len(), lines + 1);
+                n += usize::from(!piece.trim().is_empty());
+            }
+            (bytes, lines, n)
+        }
+        let mut r = Rng(0x1234_5678_9abc_def1);
+        let odd = ["", "  ", "\t", "\r", "\x0b", "\u{a0}", " 1 2", "\t3", "\r\r", "x"];
+        for round in 0..300 {
+            let mut t = String::new();
+            let rate = [10, 100, 10_000][round % 3];
+            while t.len() < 30_000 {
+                match r.below(rate) {
+                    0 => t += odd[r.below(odd.len())],
+                    1 => t += &"7 ".repeat(3000),
+                    _ => t += &format!("{} {} -{}", r.below(1000), r.below(10), r.below(100_000)),
+                }
+                t += ["\n", "\r\n"][usize::from(r.below(20) == 0)];
+            }
+            if round % 2 == 0 {
+                t.pop();
+            }
+            let want = 1 + r.below([3, 100, 5000][round % 3]);
+            let (mut offset, mut total) = (0, 0);
+            while offset < t.len() {
+                let got = take_lines(&t[offset..], want);
+                assert_eq!(got, reference(&t[offset..], want), "round {round}, at byte {offset}");
+                (offset, total) = (offset + got.0, total + got.1);
+            }
+            assert_eq!(total, t.split_inclusive('\n').count());
+        }
     }
 
     /// Both chunk readers on every chunk of `t` (at most `chunk_lines` lines
