@@ -267,12 +267,17 @@ mod tests {
         }
     }
 
-    /// `Bytes::number` on one token (read to its end when it is a number).
+    /// `Bytes::number` on one token, alone and followed by other tokens (the
+    /// reader then sees bytes past it): the same value both ways, the token
+    /// read to its end when it is a number.
     fn number(tok: &str) -> Option<f64> {
-        let mut at = Bytes { b: tok.as_bytes(), pos: 0 };
-        let v = at.number();
+        let mut alone = Bytes { b: tok.as_bytes(), pos: 0 };
+        let v = alone.number();
+        let line = format!("{tok} 1234567890\t5\n");
+        let mut followed = Bytes { b: line.as_bytes(), pos: 0 };
+        assert_eq!(followed.number().map(f64::to_bits), v.map(f64::to_bits), "{tok:?}");
         if v.is_some() {
-            assert_eq!(at.pos, tok.len(), "{tok:?} read to its end");
+            assert_eq!((alone.pos, followed.pos), (tok.len(), tok.len()), "{tok:?} read to its end");
         }
         v
     }
@@ -384,7 +389,7 @@ mod tests {
                 format!("{sign}{int}.{:0>w$}", r.below(10usize.pow(w as u32))),
             ]);
         }
-        let (mut fast, mut plain) = (0, 0);
+        let (mut fast, mut plain, mut ints) = (0, 0, 0);
         for t in &toks {
             let want = t.parse::<f64>().ok();
             let got = number(t);
@@ -397,7 +402,17 @@ mod tests {
                 plain += 1;
                 fast += usize::from(quick.is_some());
             }
+            if !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()) {
+                // Indices and counts: `str::parse::<u64>`'s value up to 18 digits.
+                let want = t.parse::<u64>().ok().filter(|_| t.len() <= 18);
+                let line = format!("{t}\t7 8\n");
+                let (mut alone, mut followed) =
+                    (Bytes { b: t.as_bytes(), pos: 0 }, Bytes { b: line.as_bytes(), pos: 0 });
+                assert_eq!((alone.integer(), followed.integer()), (want, want), "{t:?}");
+                ints += 1;
+            }
         }
+        assert!(ints > 50_000, "{ints} integer tokens");
         assert!(toks.len() > 1_000_000, "{}", toks.len());
         assert!(plain > 300_000 && fast == plain, "{fast} of {plain} plain short tokens took the fast path");
     }
