@@ -9,7 +9,7 @@
 //! before.
 //!
 //! Numbers: a token `[+-]?digits[.digits]` (`digits.` and `.digits` too) with
-//! at most 19 significant digits is an integer `m` over `10^f`. When
+//! at most 19 digits is an integer `m` over `10^f`. When
 //! `m < 2^53` and `f <= 22` both are exact doubles and one IEEE division
 //! rounds their quotient correctly (Clinger's fast path), so the value is
 //! `str::parse::<f64>`'s (correctly rounded too) bit for bit. Any other token
@@ -84,13 +84,10 @@ impl Bytes<'_> {
         let mut v = 0u64;
         let mut i = start;
         while let Some(&d) = b.get(i).filter(|d| d.is_ascii_digit()) {
-            v = v * 10 + u64::from(d - b'0');
+            v = v.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
             i += 1;
-            if i - start > 18 {
-                return None;
-            }
         }
-        if i == start || !ends_token(b.get(i)) {
+        if i == start || i - start > 18 || !ends_token(b.get(i)) {
             return None;
         }
         self.pos = i;
@@ -156,12 +153,10 @@ fn plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
         }
         _ => false,
     };
-    // `m` holds the digits; `sig` counts them from the first non-zero one (past 19
-    // `m` may have wrapped, and the token is refused).
-    let (mut m, mut sig, mut digits, mut frac) = (0u64, 0usize, 0usize, 0usize);
+    // `m` holds the digits (past 19 it may have wrapped, and the token is refused).
+    let (mut m, mut digits, mut frac) = (0u64, 0usize, 0usize);
     while let Some(&d) = b.get(i).filter(|d| d.is_ascii_digit()) {
         m = m.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
-        sig += usize::from(m != 0);
         digits += 1;
         i += 1;
     }
@@ -169,12 +164,11 @@ fn plain_number(b: &[u8], start: usize) -> Option<(f64, usize)> {
         i += 1;
         while let Some(&d) = b.get(i).filter(|d| d.is_ascii_digit()) {
             m = m.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
-            sig += usize::from(m != 0);
             frac += 1;
             i += 1;
         }
     }
-    if digits + frac == 0 || sig > 19 || m >= 1 << 53 || frac > 22 || !ends_token(b.get(i)) {
+    if digits + frac == 0 || digits + frac > 19 || m >= 1 << 53 || frac > 22 || !ends_token(b.get(i)) {
         return None;
     }
     let v = m as f64 / POW10[frac];
