@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use glam::Vec3;
 use std::path::Path;
 
+mod ascii;
 mod stream;
 pub(crate) use stream::parse_gz;
 
@@ -254,11 +255,13 @@ struct Ascii<'a> {
 }
 
 /// One part of a chunked ASCII parse: element `ei`'s lines in `range` of the
-/// text, the first of them line `first_line` of the file.
+/// text, the first of them line `first_line` of the file, `lines` of them not
+/// blank.
 struct Chunk {
     ei: usize,
     range: std::ops::Range<usize>,
     first_line: usize,
+    lines: usize,
 }
 
 impl Ascii<'_> {
@@ -303,32 +306,43 @@ impl Ascii<'_> {
     /// reports the first error as it always has.
     fn read_chunked(&self, out: &mut PlyData, chunk_lines: usize) -> bool {
         use rayon::prelude::*;
-        let mut chunks = Vec::new();
-        let mut pieces = self.text.split_inclusive('\n');
-        let (mut offset, mut ln) = (0usize, self.header_lines);
-        for (ei, el) in self.elements.iter().enumerate() {
-            let mut remaining = el.count;
-            while remaining > 0 {
-                let (start, first_line) = (offset, ln + 1);
-                let mut n = 0;
-                while n < remaining.min(chunk_lines) {
-                    let Some(piece) = pieces.next() else { return false };
-                    ln += 1;
-                    offset += piece.len();
-                    if !piece.trim().is_empty() {
-                        n += 1;
-                    }
-                }
-                chunks.push(Chunk { ei, range: start..offset, first_line });
-                remaining -= n;
-            }
-        }
+        let Some(chunks) = self.chunks(chunk_lines) else { return false };
         let parts: Vec<Option<PlyData>> = chunks.par_iter().map(|c| self.chunk(c).ok()).collect();
         append(out, parts)
     }
 
-    /// One chunk's vertices or triangles.
+    /// The body's chunks of at most `chunk_lines` non-blank lines of one
+    /// element each, in file order; `None` when the file ends early.
+    fn chunks(&self, chunk_lines: usize) -> Option<Vec<Chunk>> {
+        let mut chunks = Vec::new();
+        let (mut offset, mut ln) = (0usize, self.header_lines);
+        for (ei, el) in self.elements.iter().enumerate() {
+            let mut remaining = el.count;
+            while remaining > 0 {
+                let want = remaining.min(chunk_lines);
+                let (bytes, lines, n) = ascii::take_lines(&self.text[offset..], want);
+                if n < want {
+                    return None;
+                }
+                let start = offset;
+                offset += bytes;
+                chunks.push(Chunk { ei, range: start..offset, first_line: ln + 1, lines: n });
+                ln += lines;
+                remaining -= n;
+            }
+        }
+        Some(chunks)
+    }
+
+    /// One chunk's vertices or triangles: by the fast path
+    /// ([`Ascii::fast_chunk`]) where it can, else line by line.
     fn chunk(&self, c: &Chunk) -> Result<PlyData> {
+        self.fast_chunk(c).map_or_else(|| self.chunk_by_lines(c), Ok)
+    }
+
+    /// One chunk's vertices or triangles, line by line with [`Ascii::line`]
+    /// (the same data as [`Ascii::fast_chunk`], and the errors).
+    fn chunk_by_lines(&self, c: &Chunk) -> Result<PlyData> {
         let vertices = c.ei == self.vi;
         let mut part = PlyData {
             positions: Vec::new(),

@@ -11,6 +11,7 @@ use std::io::Read;
 use std::path::Path;
 use std::sync::{Arc, mpsc};
 
+use super::ascii::take_lines;
 use super::{ASCII_CHUNK_LINES, Ascii, Chunk, Element, Format, PlyData, append, layout_of, parse_header};
 
 /// Inflated bytes per block.
@@ -135,22 +136,15 @@ impl Scan {
     /// text's end. Lines after the last element are left alone.
     fn chunks(&mut self, text: &str, elements: &[Element]) -> Vec<(usize, Chunk)> {
         let mut out = Vec::new();
-        let mut pieces = text.split_inclusive('\n');
         let mut offset = 0;
         while self.ei < elements.len() {
             let (start, first_line) = (offset, self.ln + 1);
             let want = self.remaining.min(self.chunk_lines);
-            let mut n = 0;
-            while n < want {
-                let Some(piece) = pieces.next() else { break };
-                self.ln += 1;
-                offset += piece.len();
-                if !piece.trim().is_empty() {
-                    n += 1;
-                }
-            }
+            let (bytes, lines, n) = take_lines(&text[offset..], want);
+            self.ln += lines;
+            offset += bytes;
             if n > 0 {
-                out.push((self.chunks, Chunk { ei: self.ei, range: start..offset, first_line }));
+                out.push((self.chunks, Chunk { ei: self.ei, range: start..offset, first_line, lines: n }));
                 self.chunks += 1;
             }
             self.remaining -= n;
