@@ -354,6 +354,12 @@ pub(crate) struct Caustics {
     pub fraction: f32,
 }
 
+/// True when every delta light of `scene` is one that `caustics` aims (no
+/// beam): then `auto` may pick `caustics` for its caustics.
+pub(crate) fn aims_every_delta_light(scene: &Scene) -> bool {
+    (0..scene.light_count() as u32).all(|i| !matches!(scene.light(i), Light::Beam(_)))
+}
+
 impl Caustics {
     /// The estimator for `scene` with bounce limit `max_bounces`; `None` when
     /// there is nothing to aim ([`Aim::new`]).

@@ -342,11 +342,12 @@ fn dispersive_water_in_dispersive_glass() {
     }
 }
 
-/// With a point light and glass, `auto` picks BDPT also where media nest
-/// (its subpaths carry the medium stack; the answers are checked by the
-/// tests above, which run `bdpt` too), and says so.
+/// With a point light and glass, `auto` picks `caustics` (aimed light
+/// subpaths, BDPT's walk) also where media nest (its subpaths carry the
+/// medium stack; the answers are checked by the tests above, which run
+/// `bdpt`, `auto` and `caustics`), and says so.
 #[test]
-fn auto_picks_bdpt_among_nested_media() {
+fn auto_picks_caustics_among_nested_media() {
     let scene = water_in_glass("(0, 0, 0)", "(0.3, 0.2, -1)", 0, 0);
     let lit = format!(
         "{}], lights: [ Point(position: (0, 3, 0), intensity: Constant(1)) ])",
@@ -355,5 +356,5 @@ fn auto_picks_bdpt_among_nested_media() {
     let loaded = rust_v::scene::load_scene_str(&lit, std::path::Path::new("t.ron"), &Default::default()).unwrap();
     assert!(loaded.has_nested_volumes());
     let said = rust_v::integrator::describe(&loaded);
-    assert!(said.starts_with("auto: ") && said.contains("bidirectional"), "{said}");
+    assert!(said.starts_with("auto: ") && said.contains("light subpaths aimed"), "{said}");
 }
