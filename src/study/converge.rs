@@ -47,6 +47,7 @@ pub const METHODS: &[Method] = &[
     Method { name: "rgb", integrator: IntegratorKind::Spectral, wavelengths: Some(WavelengthsKind::Rgb) },
     Method { name: "bdpt", integrator: IntegratorKind::Bdpt, wavelengths: None },
     Method { name: "lighttrace", integrator: IntegratorKind::LightTrace, wavelengths: None },
+    Method { name: "caustics", integrator: IntegratorKind::Caustics, wavelengths: None },
 ];
 
 impl Method {
