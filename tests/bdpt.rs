@@ -6,60 +6,17 @@
 //! determinism with splats.
 
 use std::f64::consts::PI;
-use std::sync::atomic::AtomicBool;
 
 use glam::Vec3;
 
 use rust_v::film::Film;
-use rust_v::render::{Limits, render};
-use rust_v::scene::{Scene, load_scene, load_scene_str};
+use rust_v::scene::{load_scene, load_scene_str};
 use rust_v::settings::{IntegratorKind, SettingsPatch};
 
-use crate::common::{block_means, render_str, root};
-
-fn settings(integrator: IntegratorKind, size: u32, spp: u32, seed: u64) -> SettingsPatch {
-    SettingsPatch {
-        integrator: Some(integrator),
-        width: Some(size),
-        height: Some(size),
-        spp: Some(spp),
-        seed: Some(seed),
-        ..Default::default()
-    }
-}
+use crate::common::{render_into, render_str, root, seeded_blocks, square_settings};
 
 /// The expected falloff at a floor point, given `cos θ` from the light (None: skip the pixel).
 type Falloff = Box<dyn Fn(f64) -> Option<f64>>;
-
-fn render_into(scene: &Scene, film: &mut Film, passes: std::ops::Range<u32>) {
-    let stop = AtomicBool::new(false);
-    let stats = render(scene, film, passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
-    assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
-}
-
-/// Mean and standard error, per 4x4 block, over renders with different seeds;
-/// and of the image sum (the sum of a render's block means), whose standard
-/// error comes from the seeds too (blocks of one render can be correlated:
-/// a light subpath splats into several).
-fn seeded_blocks(
-    text: &str,
-    integrator: IntegratorKind,
-    size: u32,
-    spp: u32,
-    seeds: u64,
-) -> (Vec<(f64, f64)>, (f64, f64)) {
-    let runs: Vec<Vec<f64>> =
-        (0..seeds).map(|s| block_means(&render_str(text, &settings(integrator, size, spp, 100 + s)), 4)).collect();
-    let n = seeds as f64;
-    let stats = |v: &[f64]| {
-        let m = v.iter().sum::<f64>() / n;
-        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-        (m, (var / n).sqrt())
-    };
-    let blocks = (0..runs[0].len()).map(|k| stats(&runs.iter().map(|r| r[k]).collect::<Vec<_>>())).collect();
-    let sums: Vec<f64> = runs.iter().map(|r| r.iter().sum()).collect();
-    (blocks, stats(&sums))
-}
 
 /// Asserts two image sums (mean, s.e. from seeds) within 4.5 combined s.e.;
 /// prints the difference and the smallest relative bias detected with
@@ -215,9 +172,12 @@ fn delta_lights_give_the_closed_form_irradiance_by_light_tracing_and_bdpt() {
     ];
     for (light, falloff) in &cases {
         let text = base.replace("LIGHT", light);
-        let scene =
-            load_scene_str(&text, std::path::Path::new("t.ron"), &settings(IntegratorKind::LightTrace, 16, 1024, 1))
-                .unwrap();
+        let scene = load_scene_str(
+            &text,
+            std::path::Path::new("t.ron"),
+            &square_settings(IntegratorKind::LightTrace, 16, 1024, 1),
+        )
+        .unwrap();
         let want: Vec<Option<f64>> = (0..256)
             .map(|k| {
                 let (x, y) = ((k % 16) as f32 + 0.5, (k / 16) as f32 + 0.5);
@@ -236,7 +196,7 @@ fn delta_lights_give_the_closed_form_irradiance_by_light_tracing_and_bdpt() {
         {
             let ratios: Vec<f64> = (0..SEEDS)
                 .map(|seed| {
-                    let img = render_str(&text, &settings(integrator, 16, 1024, 1 + seed)).mean_xyz();
+                    let img = render_str(&text, &square_settings(integrator, 16, 1024, 1 + seed)).mean_xyz();
                     let (mut got, mut exp) = (0.0, 0.0);
                     for q in 0..4 {
                         let (mut gq, mut eq) = (0.0, 0.0);
@@ -364,7 +324,7 @@ fn ball_lens_caustic_matches_a_numerical_trace_and_the_focal_formula() {
     let want_centre: f64 = centre.iter().map(|&k| flux[k]).sum();
     assert!(want_centre > 0.3 * want_total, "the focus holds most of the flux");
     for integrator in [IntegratorKind::LightTrace, IntegratorKind::Bdpt] {
-        let film = render_str(&text, &settings(integrator, size as u32, 32, 3));
+        let film = render_str(&text, &square_settings(integrator, size as u32, 32, 3));
         // Pixel radiance ρE/π, so the flux through a pixel is π L / ρ × its area.
         let got: Vec<f64> = film.mean_xyz().iter().map(|p| PI * p[1] / rho * pixel_area).collect();
         let total: f64 = got.iter().sum();
@@ -373,7 +333,7 @@ fn ball_lens_caustic_matches_a_numerical_trace_and_the_focal_formula() {
         assert!((at_centre / want_centre - 1.0).abs() < 0.05, "{integrator:?}: focus {at_centre} vs {want_centre}");
     }
     // Path tracing cannot find this caustic at all (the failure matrix's row).
-    let path = render_str(&text, &settings(IntegratorKind::Path, size as u32, 4, 3));
+    let path = render_str(&text, &square_settings(IntegratorKind::Path, size as u32, 4, 3));
     assert!(path.mean_xyz().iter().all(|p| p[1] == 0.0));
 }
 
@@ -442,7 +402,7 @@ fn prism_rainbow_bands_sit_where_snell_puts_them() {
 fn bdpt_is_deterministic_and_merges_exactly() {
     let text = scene_text("caustic-point.ron");
     for integrator in [IntegratorKind::Bdpt, IntegratorKind::LightTrace] {
-        let o = settings(integrator, 24, 6, 5);
+        let o = square_settings(integrator, 24, 6, 5);
         let scene = load_scene_str(&text, &root().join("scenes/caustic-point.ron"), &o).unwrap();
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();

@@ -4,42 +4,11 @@
 //! means (independent estimators of the same image), for bit-identity
 //! with `path` where there is nothing to aim, and for determinism.
 
-use std::sync::atomic::AtomicBool;
-
 use rust_v::film::Film;
-use rust_v::render::{Limits, render};
 use rust_v::scene::load_scene_str;
-use rust_v::settings::{IntegratorKind, SettingsPatch};
+use rust_v::settings::IntegratorKind;
 
-use crate::common::{block_means, render_str, root};
-
-fn settings(integrator: IntegratorKind, size: u32, spp: u32, seed: u64) -> SettingsPatch {
-    SettingsPatch {
-        integrator: Some(integrator),
-        width: Some(size),
-        height: Some(size),
-        spp: Some(spp),
-        seed: Some(seed),
-        ..Default::default()
-    }
-}
-
-/// Per 4x4 block: the mean over `seeds` renders and its standard error from
-/// the seeds' spread (a light subpath splats anywhere, so the seeds, not
-/// the pixels, give the error).
-fn seeded_blocks(text: &str, integrator: IntegratorKind, size: u32, spp: u32, seeds: u64) -> Vec<(f64, f64)> {
-    let runs: Vec<Vec<f64>> =
-        (0..seeds).map(|s| block_means(&render_str(text, &settings(integrator, size, spp, 100 + s)), 4)).collect();
-    let n = seeds as f64;
-    (0..runs[0].len())
-        .map(|k| {
-            let v: Vec<f64> = runs.iter().map(|r| r[k]).collect();
-            let m = v.iter().sum::<f64>() / n;
-            let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-            (m, (var / n).sqrt())
-        })
-        .collect()
-}
+use crate::common::{render_into, render_str, root, seeded_blocks, square_settings};
 
 /// Asserts every block of `a` within 4.5 combined standard errors (+1e-4)
 /// of `b`'s (16 blocks: all pass by chance with probability > 99.9%), and
@@ -85,8 +54,8 @@ fn glass_over_floor(light: &str) -> String {
 #[test]
 fn caustics_matches_path_under_a_uniform_environment() {
     let text = glass_over_floor("environment: Uniform(Constant(1)),");
-    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24);
-    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24).0;
+    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
     assert_blocks_agree("uniform environment, caustics vs path", &caustics, &path);
 }
 
@@ -98,8 +67,8 @@ fn caustics_matches_bdpt_under_the_sky_with_its_sun() {
     let text = glass_over_floor(
         "environment: Sky(sun_elevation_deg: 50, sun_azimuth_deg: 20, turbidity: 3, ground_albedo: 0.3, scale: 0.05),",
     );
-    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
-    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24).0;
+    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
     assert_blocks_agree("sky with sun, caustics vs bdpt", &caustics, &bdpt);
 }
 
@@ -111,9 +80,9 @@ fn caustics_matches_bdpt_under_the_sky_with_its_sun() {
 #[test]
 fn a_distant_lights_caustic_that_path_tracing_misses() {
     let text = glass_over_floor("lights: [ Distant(direction: (0.25, -1, -0.3), irradiance: Constant(3)) ],");
-    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
-    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
-    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24);
+    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24).0;
+    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
+    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24).0;
     assert_blocks_agree("distant light, caustics vs bdpt", &caustics, &bdpt);
     let (k, gap) =
         bdpt.iter().zip(&path).map(|(b, p)| b.0 - p.0).enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
@@ -133,8 +102,8 @@ fn point_and_spot_light_caustics_match_bdpt() {
         "lights: [ Spot(position: (0.3, 2.2, 0.2), look_at: (0, 0, 0), cone_deg: 30, falloff_deg: 10, intensity: Constant(4)) ],",
     ] {
         let text = glass_over_floor(light);
-        let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24);
-        let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24);
+        let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24).0;
+        let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
         assert_blocks_agree(&format!("{light} caustics vs bdpt"), &caustics, &bdpt);
     }
 }
@@ -158,8 +127,8 @@ fn a_blocked_target_raises_the_rate_and_stays_unbiased() {
         ],
         lights: [ Distant(direction: (0, -1, 0), irradiance: Constant(3)) ],
     )"#;
-    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 16, 24);
-    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24);
+    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 16, 24).0;
+    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
     assert_blocks_agree("a roof with a slot, caustics vs bdpt", &caustics, &bdpt);
 }
 
@@ -182,8 +151,8 @@ fn a_target_that_encloses_the_camera() {
         ],
         environment: Uniform(Constant(1)),
     )"#;
-    let path = seeded_blocks(text, IntegratorKind::Path, 16, 16, 24);
-    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24);
+    let path = seeded_blocks(text, IntegratorKind::Path, 16, 16, 24).0;
+    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
     assert_blocks_agree("camera inside a glass dome, caustics vs path", &caustics, &path);
 }
 
@@ -210,17 +179,11 @@ fn nothing_to_aim_at_renders_as_path() {
         ],
     )"#;
     for (what, text) in [("no specular surface", diffuse.to_string()), ("only an area light", area_light.to_string())] {
-        let path = render_str(&text, &settings(IntegratorKind::Path, 16, 4, 3));
-        let caustics = render_str(&text, &settings(IntegratorKind::Caustics, 16, 4, 3));
+        let path = render_str(&text, &square_settings(IntegratorKind::Path, 16, 4, 3));
+        let caustics = render_str(&text, &square_settings(IntegratorKind::Caustics, 16, 4, 3));
         assert!(path.mean_xyz().iter().any(|p| p[1] > 0.0), "{what}: black");
         assert_eq!(caustics, path, "{what}");
     }
-}
-
-fn render_into(scene: &rust_v::scene::Scene, film: &mut Film, passes: std::ops::Range<u32>) {
-    let stop = AtomicBool::new(false);
-    let stats = render(scene, film, passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
-    assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
 }
 
 /// Splats keep every guarantee: the image is bit-identical for 1 and 2
@@ -228,7 +191,8 @@ fn render_into(scene: &rust_v::scene::Scene, film: &mut Film, passes: std::ops::
 #[test]
 fn caustics_is_deterministic_and_merges_exactly() {
     let text = glass_over_floor("lights: [ Distant(direction: (0.25, -1, -0.3), irradiance: Constant(3)) ],");
-    let scene = load_scene_str(&text, &root().join("t.ron"), &settings(IntegratorKind::Caustics, 24, 6, 5)).unwrap();
+    let scene =
+        load_scene_str(&text, &root().join("t.ron"), &square_settings(IntegratorKind::Caustics, 24, 6, 5)).unwrap();
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     let whole = |pool: &rayon::ThreadPool| {
@@ -247,7 +211,7 @@ fn caustics_is_deterministic_and_merges_exactly() {
     a.merge(&b).unwrap();
     assert_eq!(a, whole1, "merged halves");
     // The light side splatted something: the image differs from path tracing's.
-    let path = load_scene_str(&text, &root().join("t.ron"), &settings(IntegratorKind::Path, 24, 6, 5)).unwrap();
+    let path = load_scene_str(&text, &root().join("t.ron"), &square_settings(IntegratorKind::Path, 24, 6, 5)).unwrap();
     let mut p = Film::new(24, 24);
     render_into(&path, &mut p, 0..6);
     assert_ne!(p, whole1);
@@ -263,10 +227,11 @@ fn scattering_media_are_refused() {
         objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass", interior: "fog") ],
         environment: Uniform(Constant(1)),
     )"#;
-    let Err(e) = load_scene_str(text, &root().join("t.ron"), &settings(IntegratorKind::Caustics, 8, 1, 1)) else {
+    let Err(e) = load_scene_str(text, &root().join("t.ron"), &square_settings(IntegratorKind::Caustics, 8, 1, 1))
+    else {
         panic!("a scattering medium loads with caustics");
     };
     let msg = e.to_string();
     assert!(msg.contains("objects[0].interior") && msg.contains("caustics") && msg.contains("bdpt"), "{msg}");
-    assert!(load_scene_str(text, &root().join("t.ron"), &settings(IntegratorKind::Bdpt, 8, 1, 1)).is_ok());
+    assert!(load_scene_str(text, &root().join("t.ron"), &square_settings(IntegratorKind::Bdpt, 8, 1, 1)).is_ok());
 }

@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use rust_v::film::Film;
 use rust_v::render::{Limits, render};
 use rust_v::scene::load_scene_str;
-use rust_v::settings::SettingsPatch;
+use rust_v::settings::{IntegratorKind, SettingsPatch};
 
 /// The repository root.
 pub fn root() -> PathBuf {
@@ -118,4 +118,48 @@ pub fn pixel_squares(scene: &rust_v::scene::Scene, n: u32, scale: f32) -> Vec<Op
         corners.iter().all(|c| *c == Some(first)).then_some(first)
     };
     (0..n * n).map(|k| square(k % n, k / n)).collect()
+}
+
+/// Settings for a `size`² render with `integrator`, `spp` and `seed`.
+pub fn square_settings(integrator: IntegratorKind, size: u32, spp: u32, seed: u64) -> SettingsPatch {
+    SettingsPatch {
+        integrator: Some(integrator),
+        width: Some(size),
+        height: Some(size),
+        spp: Some(spp),
+        seed: Some(seed),
+        ..Default::default()
+    }
+}
+
+/// Renders `passes` of `scene` into `film`, asserting no NaN or infinite sample.
+pub fn render_into(scene: &rust_v::scene::Scene, film: &mut Film, passes: std::ops::Range<u32>) {
+    let stop = AtomicBool::new(false);
+    let stats = render(scene, film, passes, Limits { stop: &stop, time_budget: None }, &mut |_, _| {});
+    assert_eq!(stats.invalid_samples, 0, "NaN or infinite samples");
+}
+
+/// Mean and standard error, per 4x4 block, over renders with different seeds;
+/// and of the image sum (the sum of a render's block means), whose standard
+/// error comes from the seeds too (blocks of one render can be correlated:
+/// a light subpath splats into several).
+pub fn seeded_blocks(
+    text: &str,
+    integrator: IntegratorKind,
+    size: u32,
+    spp: u32,
+    seeds: u64,
+) -> (Vec<(f64, f64)>, (f64, f64)) {
+    let runs: Vec<Vec<f64>> = (0..seeds)
+        .map(|s| block_means(&render_str(text, &square_settings(integrator, size, spp, 100 + s)), 4))
+        .collect();
+    let n = seeds as f64;
+    let stats = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+        (m, (var / n).sqrt())
+    };
+    let blocks = (0..runs[0].len()).map(|k| stats(&runs.iter().map(|r| r[k]).collect::<Vec<_>>())).collect();
+    let sums: Vec<f64> = runs.iter().map(|r| r.iter().sum()).collect();
+    (blocks, stats(&sums))
 }

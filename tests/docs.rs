@@ -484,3 +484,25 @@ fn every_test_the_failure_matrix_names_exists() {
     assert!(seen > 40, "found only {seen} test names: is the table's format still understood?");
     assert!(missing.is_empty(), "tests named in the matrix that do not exist:\n{}", missing.join("\n"));
 }
+
+/// Every source file under `src/` stays within 700 lines (the house limit:
+/// a longer file holds more than one concept and is split along them).
+#[test]
+fn source_files_stay_within_700_lines() {
+    fn walk(dir: &Path, long: &mut Vec<String>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let p = entry.unwrap().path();
+            if p.is_dir() {
+                walk(&p, long);
+            } else if p.extension().is_some_and(|e| e == "rs") {
+                let n = read(&p).lines().count();
+                if n > 700 {
+                    long.push(format!("{} ({n} lines)", p.display()));
+                }
+            }
+        }
+    }
+    let mut long = Vec::new();
+    walk(&root().join("src"), &mut long);
+    assert!(long.is_empty(), "split these along the concepts they hold: {long:?}");
+}

@@ -90,7 +90,6 @@ use glam::{Vec2, Vec3};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
 use crate::light::EmissionSample;
-use crate::light::Light;
 use crate::sampler::warp::{concentric_disk, uniform_sphere};
 use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
@@ -131,9 +130,7 @@ impl Aim {
         let spheres: Vec<(Vec3, f32)> =
             spheres.into_iter().filter(|(c, r)| c.is_finite() && r.is_finite() && *r > 0.0).collect();
         let lights: Vec<(u32, f32)> = (0..scene.light_count() as u32)
-            .filter(|&i| {
-                matches!(scene.light(i), Light::Environment(_) | Light::Distant(_) | Light::Point(_) | Light::Spot(_))
-            })
+            .filter(|&i| scene.light(i).can_be_aimed())
             .map(|i| (i, scene.light(i).power().max(0.0)))
             .filter(|(_, p)| p.is_finite() && *p > 0.0)
             .collect();
@@ -199,7 +196,7 @@ impl Aim {
 
     /// A ray leaving aimed light `index`, drawn with `u_pos` and `u_dir`. A
     /// parallel bundle (the environment, a distant light): the direction as
-    /// [`Light::sample_le`] draws it, the origin by [`Aim::sample_origin`]
+    /// [`crate::light::Light::sample_le`] draws it, the origin by [`Aim::sample_origin`]
     /// (its density in `pdf_pos`). A point or spot light: its position, and a
     /// direction by [`Aim::sample_direction`] (its density in `pdf_dir`; a
     /// spot's falloff in `scale`).
@@ -357,7 +354,10 @@ pub(crate) struct Caustics {
 /// True when every delta light of `scene` is one that `caustics` aims (no
 /// beam): then `auto` may pick `caustics` for its caustics.
 pub(crate) fn aims_every_delta_light(scene: &Scene) -> bool {
-    (0..scene.light_count() as u32).all(|i| !matches!(scene.light(i), Light::Beam(_)))
+    (0..scene.light_count() as u32).all(|i| {
+        let light = scene.light(i);
+        !light.is_delta() || light.can_be_aimed()
+    })
 }
 
 impl Caustics {

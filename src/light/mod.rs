@@ -188,6 +188,15 @@ impl Light {
         }
     }
 
+    /// True for the lights whose rays `--integrator caustics` aims at specular
+    /// objects: the environment, distant lights (an origin on disks over the
+    /// objects) and point and spot lights (a direction in their cones); not
+    /// area lights or beams.
+    #[inline]
+    pub fn can_be_aimed(&self) -> bool {
+        matches!(self, Light::Environment(_) | Light::Distant(_) | Light::Point(_) | Light::Spot(_))
+    }
+
     /// True for the environment (a light at infinity, non-delta: escaped rays see it).
     #[inline]
     pub fn is_infinite(&self) -> bool {

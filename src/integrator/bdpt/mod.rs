@@ -208,7 +208,7 @@ impl Estimator for Bdpt {
                     };
                 }
             }
-            self.light_subpath(scene, sampler, light, track.then_some(&mut *light_media), &mut wl);
+            self.light_subpath(scene, None, sampler, light, track.then_some(&mut *light_media), &mut wl);
             let max = self.max_bounces as usize;
             let (camera, light) = (Sub { v: camera, media: camera_media }, Sub { v: light, media: light_media });
             let t_range = if self.light_only { 1..=1 } else { 1..=camera.v.len() };
@@ -269,7 +269,7 @@ impl Bdpt {
             light_media.clear();
             let track = scene.has_volumes();
             let mut wl = Wavelength { u: sampler.get_1d(Dim::wavelength(1)), continuous: O::CONTINUOUS, drawn: None };
-            self.aimed_subpath(scene, aim, sampler, light, track.then_some(&mut *light_media), &mut wl);
+            self.light_subpath(scene, Some(aim), sampler, light, track.then_some(&mut *light_media), &mut wl);
             if light.len() < 3 || !light[1].delta {
                 return;
             }
@@ -311,48 +311,35 @@ impl Bdpt {
         walk.run(scene, ray, Spectrum::ONE, pdf_dir, false, sampler, path, stacks, scene.camera_volumes, wl);
     }
 
-    /// A light by power, a ray leaving it, and its walk.
+    /// A light subpath: a light by power and a ray leaving it ([`crate::light::Light::sample_le`]);
+    /// or, for `caustics`' light side (`aim`), an aimed light by
+    /// [`Aim::choose_light`] and its ray by [`Aim::aimed_ray`], the walk then
+    /// ending at its first surface vertex unless that scattered through a delta
+    /// lobe. Both draw the same dimensions in the same order.
     fn light_subpath(
         &self,
         scene: &Scene,
+        aim: Option<&Aim>,
         sampler: &mut Sampler,
         path: &mut Vec<Vertex>,
         stacks: Option<&mut Vec<VolumeStack>>,
         wl: &mut Wavelength,
     ) {
-        let u_light = sampler.get_1d_if(scene.light_count() > 1, Dim::EMIT_CHOICE);
+        let lights = aim.map_or(scene.light_count(), Aim::light_count);
+        let u_light = sampler.get_1d_if(lights > 1, Dim::EMIT_CHOICE);
         let (u_pos, u_dir) = (sampler.get_2d(Dim::EMIT_POSITION), sampler.get_2d(Dim::EMIT_DIRECTION));
-        let Some((index, pmf)) = scene.choose_light(u_light) else {
-            return;
+        let ray = match aim {
+            None => scene.choose_light(u_light).and_then(|(index, pmf)| {
+                let index = index as u32;
+                scene.light(index).sample_le(u_pos, u_dir).map(|e| (index, pmf, e))
+            }),
+            Some(aim) => aim
+                .choose_light(u_light)
+                .and_then(|(index, pmf)| aim.aimed_ray(scene, index, u_pos, u_dir).map(|e| (index, pmf, e))),
         };
-        let light = scene.light(index as u32);
-        let Some(e) = light.sample_le(u_pos, u_dir) else {
-            return;
-        };
-        self.walk_from_light(scene, index as u32, pmf, e, false, sampler, path, stacks, wl);
-    }
-
-    /// The light subpath of `caustics`' light side: an aimed light by
-    /// [`Aim::choose_light`], its ray by [`Aim::aimed_ray`]; the walk ends at
-    /// its first surface vertex unless that scattered through a delta lobe.
-    fn aimed_subpath(
-        &self,
-        scene: &Scene,
-        aim: &Aim,
-        sampler: &mut Sampler,
-        path: &mut Vec<Vertex>,
-        stacks: Option<&mut Vec<VolumeStack>>,
-        wl: &mut Wavelength,
-    ) {
-        let u_light = sampler.get_1d_if(aim.light_count() > 1, Dim::EMIT_CHOICE);
-        let (u_pos, u_dir) = (sampler.get_2d(Dim::EMIT_POSITION), sampler.get_2d(Dim::EMIT_DIRECTION));
-        let Some((index, pmf)) = aim.choose_light(u_light) else {
-            return;
-        };
-        let Some(e) = aim.aimed_ray(scene, index, u_pos, u_dir) else {
-            return;
-        };
-        self.walk_from_light(scene, index, pmf, e, true, sampler, path, stacks, wl);
+        if let Some((index, pmf, e)) = ray {
+            self.walk_from_light(scene, index, pmf, e, aim.is_some(), sampler, path, stacks, wl);
+        }
     }
 
     /// The light vertex of ray `e` leaving light `index` (chosen with
