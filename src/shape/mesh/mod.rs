@@ -421,65 +421,63 @@ enum Bad {
     Index(usize, u32, usize),
 }
 
-/// Runs `one(first index, chunk, out)` over `items` in order: in parallel over fixed
-/// chunks joined in order when there are many, so the output and the first problem
-/// are those of one pass.
-fn in_chunks<T: Sync, O: Send + Default>(
+/// Runs `one(first index, items chunk, out chunk)` over `items` and an output of the
+/// same length, chunk by chunk: in parallel over fixed chunks when there are many (each
+/// chunk writes its own part of the output, so its pages are first touched, and zeroed,
+/// by the thread that fills them), in one pass otherwise. Returns what the chunks
+/// returned, in order, or the first problem in order: the output and the error are
+/// those of one pass in order.
+fn in_chunks<T: Sync, O: Send, R: Send>(
     items: &[T],
-    one: impl Fn(usize, &[T], &mut O) -> std::result::Result<(), Bad> + Sync,
-    join: impl Fn(&mut O, O),
-) -> std::result::Result<O, Bad> {
-    let mut out = O::default();
+    out: &mut [O],
+    one: impl Fn(usize, &[T], &mut [O]) -> std::result::Result<R, Bad> + Sync,
+) -> std::result::Result<Vec<R>, Bad> {
+    debug_assert_eq!(items.len(), out.len());
     if items.len() <= PARALLEL_PLACE {
-        one(0, items, &mut out)?;
-        return Ok(out);
+        return Ok(vec![one(0, items, out)?]);
     }
-    let parts: Vec<std::result::Result<O, Bad>> = items
+    let parts: Vec<std::result::Result<R, Bad>> = items
         .par_chunks(PLACE_CHUNK)
+        .zip(out.par_chunks_mut(PLACE_CHUNK))
         .enumerate()
-        .map(|(c, chunk)| {
-            let mut o = O::default();
-            one(c * PLACE_CHUNK, chunk, &mut o).map(|_| o)
-        })
+        .map(|(c, (chunk, o))| one(c * PLACE_CHUNK, chunk, o))
         .collect();
-    for part in parts {
-        join(&mut out, part?);
-    }
-    Ok(out)
+    parts.into_iter().collect()
 }
 
 /// The vertices `original` under `m · p + translate`; the first vertex (in order) that
-/// is not finite before or after is the error.
+/// is not finite before or after is the error. Large meshes are placed, then checked,
+/// in parallel (rayon writes each part of the output from the thread that computes it).
 fn place_vertices(original: &[Vec3], m: Mat3, translate: Vec3, err: &dyn Fn(String) -> Error) -> Result<Vec<Vec3>> {
-    let placed = in_chunks(
-        original,
-        |base, ps, out: &mut Vec<Vec3>| {
-            out.reserve_exact(ps.len());
-            for (k, p) in ps.iter().enumerate() {
-                if !p.is_finite() {
-                    return Err(Bad::Vertex(base + k, *p));
-                }
-                let q = m * *p + translate;
-                if !q.is_finite() {
-                    return Err(Bad::Placed(base + k));
-                }
-                out.push(q);
-            }
-            Ok(())
-        },
-        |out, part| {
-            if out.is_empty() {
-                out.reserve_exact(original.len());
-            }
-            out.extend_from_slice(&part)
-        },
-    );
-    placed.map_err(|bad| bad.error(err))
+    let place = |p: &Vec3| m * *p + translate;
+    let bad = |(i, (p, q)): (usize, (&Vec3, &Vec3))| {
+        if !p.is_finite() {
+            Some(Bad::Vertex(i, *p))
+        } else if !q.is_finite() {
+            Some(Bad::Placed(i))
+        } else {
+            None
+        }
+    };
+    let mut out = Vec::new();
+    let first_bad = if original.len() <= PARALLEL_PLACE {
+        out.extend(original.iter().map(place));
+        original.iter().zip(&out).enumerate().find_map(bad)
+    } else {
+        original.par_iter().with_min_len(PLACE_CHUNK).map(place).collect_into_vec(&mut out);
+        original.par_iter().zip(&out).enumerate().with_min_len(PLACE_CHUNK).find_map_first(bad)
+    };
+    match first_bad {
+        Some(b) => Err(b.error(err)),
+        None => Ok(out),
+    }
 }
 
 /// The triangles of `indices` with an area (in `positions`), two vertices swapped
 /// when `mirror`, and the file-order indices of those without; an index out of range
-/// is an error (the first, in order).
+/// is an error (the first, in order). Each chunk packs its kept triangles at the start
+/// of its own part of the output; the parts are closed up after, which moves nothing
+/// when no triangle was dropped (the usual case).
 fn keep_triangles(
     positions: &[Vec3],
     indices: &[[u32; 3]],
@@ -487,34 +485,37 @@ fn keep_triangles(
     err: &dyn Fn(String) -> Error,
 ) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
     let nv = positions.len();
-    let kept = in_chunks(
-        indices,
-        |base, tris, (kept, dropped): &mut (Vec<[u32; 3]>, Vec<u32>)| {
-            kept.reserve_exact(tris.len());
-            for (k, tri) in tris.iter().enumerate() {
-                if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
-                    return Err(Bad::Index(base + k, bad, nv));
-                }
-                let tri = if mirror { [tri[0], tri[2], tri[1]] } else { *tri };
-                let [a, b, c] = tri.map(|i| positions[i as usize]);
-                let area2 = (b - a).cross(c - a).length_squared();
-                if area2 > 0.0 && area2.is_finite() {
-                    kept.push(tri);
-                } else {
-                    dropped.push((base + k) as u32);
-                }
+    let mut kept = vec![[0u32; 3]; indices.len()];
+    let parts = in_chunks(indices, &mut kept, |base, tris, out| {
+        let mut n = 0;
+        let mut dropped = Vec::new();
+        for (k, tri) in tris.iter().enumerate() {
+            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= nv) {
+                return Err(Bad::Index(base + k, bad, nv));
             }
-            Ok(())
-        },
-        |(kept, dropped), (k, d)| {
-            if kept.is_empty() {
-                kept.reserve_exact(indices.len());
+            let tri = if mirror { [tri[0], tri[2], tri[1]] } else { *tri };
+            let [a, b, c] = tri.map(|i| positions[i as usize]);
+            let area2 = (b - a).cross(c - a).length_squared();
+            if area2 > 0.0 && area2.is_finite() {
+                out[n] = tri;
+                n += 1;
+            } else {
+                dropped.push((base + k) as u32);
             }
-            kept.extend_from_slice(&k);
-            dropped.extend_from_slice(&d);
-        },
-    );
-    kept.map_err(|bad| bad.error(err))
+        }
+        Ok((n, dropped))
+    })
+    .map_err(|bad| bad.error(err))?;
+    let chunk = if indices.len() <= PARALLEL_PLACE { indices.len() } else { PLACE_CHUNK };
+    let mut end = 0;
+    let mut dropped = Vec::new();
+    for (c, (n, d)) in parts.into_iter().enumerate() {
+        kept.copy_within(c * chunk..c * chunk + n, end);
+        end += n;
+        dropped.extend(d);
+    }
+    kept.truncate(end);
+    Ok((kept, dropped))
 }
 
 impl Bad {
