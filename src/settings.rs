@@ -74,7 +74,7 @@ macro_rules! named_enum {
 named_enum! {
     /// The light-transport methods ([`crate::integrator`]).
     IntegratorKind {
-        /// The default: picks `caustics` when a point, spot or distant light or the sky's sun meets a specular surface (caustics path tracing cannot find; `bdpt` where a beam does, or with a scattering medium), `bdpt` when a delta light meets a scattering medium (light subpaths start in its beam), else path tracing with the full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
+        /// The default: picks `caustics` when a point, spot or distant light or a sun (the sky's, or a map's: half its power within 1% of the sphere) meets a specular surface (caustics path tracing cannot find; `bdpt` where a beam does, or with a scattering medium), `bdpt` when a delta light meets a scattering medium (light subpaths start in its beam), else path tracing with the full spectrum until a path refracts at a dispersive surface, then single wavelengths drawn by importance.
         Auto = "auto",
         /// Full-spectrum path tracing with next-event estimation and MIS; no dispersion.
         Path = "path",

@@ -162,3 +162,88 @@ fn path_bdpt_and_light_tracing_agree_under_an_image_map() {
         assert!(m.abs() < tol, "{integrator}: mean Y differs from path by {m} ± {se} (image mean {mean_ref})");
     }
 }
+
+/// `auto` treats a map's peak as a sun (and picks `caustics` over specular
+/// surfaces) when its brightest texels holding `SUN_SHARE` (half) of its power
+/// span at most `SUN_SOLID_ANGLE` (1% of the sphere). Grey maps, so a texel's
+/// power is its value times its solid angle up to one constant; the shares and
+/// solid angles are computed here, independently of the renderer's histogram.
+#[test]
+fn a_map_has_a_sun_when_half_its_power_lies_within_one_percent_of_the_sphere() {
+    use rust_v::light::{EnvironmentLight, SUN_SHARE, SUN_SOLID_ANGLE};
+    use std::f64::consts::PI;
+    let (w, h) = (64usize, 32usize);
+    let solid = |j: usize| {
+        let (t0, t1) = (PI * j as f64 / h as f64, PI * (j + 1) as f64 / h as f64);
+        2.0 * PI / w as f64 * (t0.cos() - t1.cos())
+    };
+    // A dim background of 0.01 and a square spot of `side` texels at the equator.
+    let map = |side: usize, value: f32| {
+        let mut px = vec![[0.01f32; 3]; w * h];
+        for j in h / 2 - side / 2..h / 2 - side / 2 + side {
+            for i in 10..10 + side {
+                px[j * w + i] = [value; 3];
+            }
+        }
+        let (mut spot, mut spot_solid, mut total) = (0.0, 0.0, 0.0);
+        for j in 0..h {
+            for i in 0..w {
+                let p = px[j * w + i][0] as f64 * solid(j);
+                total += p;
+                if px[j * w + i][0] == value {
+                    spot += p;
+                    spot_solid += solid(j);
+                }
+            }
+        }
+        let sun = EnvironmentLight::map(w, h, &px, 1.0, glam::Mat3::IDENTITY).unwrap().has_sun();
+        (sun, spot / total, spot_solid)
+    };
+    // 2x2 texels (0.039 sr) holding 84%: a sun.
+    let (sun, share, sr) = map(2, 17.0);
+    assert!(share > SUN_SHARE && sr < SUN_SOLID_ANGLE && sun, "{share} in {sr} sr");
+    // The same spot holding 33%: the brightest texels holding half the power
+    // take in background texels: most of the sphere. No sun.
+    let (sun, share, _) = map(2, 1.6);
+    assert!(share < SUN_SHARE && !sun, "{share}");
+    // A 6x6 spot (0.35 sr, 2.7% of the sphere) holding 92%: too broad for a sun.
+    let (sun, share, sr) = map(6, 4.0);
+    assert!(share > SUN_SHARE && sr > SUN_SOLID_ANGLE && !sun, "{share} in {sr} sr");
+    // A uniform map, a uniform environment and the sky.
+    assert!(!EnvironmentLight::map(w, h, &vec![[1.0; 3]; w * h], 1.0, glam::Mat3::IDENTITY).unwrap().has_sun());
+    assert!(!EnvironmentLight::uniform(rust_v::color::Spectrum::splat(1.0)).has_sun());
+}
+
+/// Over a glass sphere, `auto` picks `caustics` under a map with a sun and path
+/// tracing under the same map with its spot dimmed below half the power.
+#[test]
+fn auto_aims_at_glass_from_a_map_with_a_sun_only() {
+    let dir = temp_dir("env_auto_sun");
+    let (w, h) = (64u32, 32u32);
+    for (name, spot) in [("sun.exr", 17.0f32), ("dim.exr", 1.6)] {
+        let mut px = vec![0.01f32; (w * h * 3) as usize];
+        for j in 15..17 {
+            for i in 10..12 {
+                let k = ((j * w + i) * 3) as usize;
+                px[k..k + 3].fill(spot);
+            }
+        }
+        image::Rgb32FImage::from_raw(w, h, px).unwrap().save(dir.join(name)).unwrap();
+    }
+    let line = |map: &str| {
+        let text = format!(
+            r#"(camera: (eye: (0, 0, 5), look_at: (0, 0, 0), fov_deg: 30),
+            materials: {{ "glass": Dielectric(ior: Constant(1.5)), "floor": Lambertian(reflectance: Constant(0.5)) }},
+            objects: [ (shape: Sphere(center: (0, 0, 0), radius: 1), material: "glass"),
+                       (shape: Quad(origin: (-3, -1, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor") ],
+            environment: Image(path: "{map}"))"#
+        );
+        let path = dir.join("scene.ron");
+        std::fs::write(&path, text).unwrap();
+        rust_v::integrator::describe(&rust_v::scene::load_scene(&path, &SettingsPatch::default()).unwrap())
+    };
+    let sun = line("sun.exr");
+    assert!(sun.contains("the environment's sun") && sun.contains("light subpaths aimed"), "{sun}");
+    let dim = line("dim.exr");
+    assert!(dim.contains("full-spectrum path tracing") && !dim.contains("aimed"), "{dim}");
+}

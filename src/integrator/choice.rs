@@ -81,7 +81,9 @@ fn auto_pick(scene: &Scene) -> Auto {
         (true, true) => {
             "a point, spot, distant or beam light meets a specular surface (caustics path tracing cannot find)"
         }
-        (true, false) => "the sky's sun meets a specular surface (caustics path tracing cannot find)",
+        (true, false) => {
+            "the environment's sun (the sky's, or a map's: half its power within 1% of the sphere) meets a specular surface (caustics path tracing cannot find)"
+        }
         _ => "a point, spot, distant or beam light meets a scattering medium (light subpaths start in its beam)",
     };
     let s = &scene.settings;
@@ -101,7 +103,8 @@ fn auto_pick(scene: &Scene) -> Auto {
 /// it: on `milky-water.ron` BDPT's error at equal time is a third of path
 /// tracing's or less). The sky's sun, half a degree across, counts as a
 /// delta light for caustics (a camera path reaches it through smooth glass
-/// only by hitting its disk). `auto` then leaves path tracing for
+/// only by hitting its disk), and so does a map's sun
+/// ([`crate::light::EnvironmentLight::has_sun`]). `auto` then leaves path tracing for
 /// `caustics` or `bdpt` (`auto_pick`).
 pub fn needs_bdpt(scene: &Scene) -> bool {
     let caustics = scene.has_delta_surface() && (scene.has_delta_light() || scene.has_sun());
@@ -199,7 +202,7 @@ mod tests {
     use crate::settings::SettingsPatch;
 
     /// What `auto` picks, and the reason it prints: `caustics` for a spot and
-    /// for the sky's sun on glass; BDPT for a beam on glass (not aimed) and a
+    /// for the sky's sun on glass (a map's sun: `tests/environment.rs`); BDPT for a beam on glass (not aimed) and a
     /// spot in a scattering medium; path tracing for an index-matched boundary
     /// under a spot, and for a uniform environment over glass.
     #[test]
@@ -226,7 +229,7 @@ mod tests {
             (scene(glass, spot, "", ""), Some(("specular surface", aimed))),
             (scene(glass, beam, "", ""), Some(("specular surface", bidir))),
             (scene("Interface", spot, milk, r#", interior: "milk""#), Some(("scattering medium", bidir))),
-            (scene(glass, sky, "", ""), Some(("the sky's sun", aimed))),
+            (scene(glass, sky, "", ""), Some(("the environment's sun", aimed))),
             (scene("Interface", spot, "", ""), None),
             (scene(glass, "environment: Uniform(Constant(1))", "", ""), None),
             (scene("Interface", sky, milk, r#", interior: "milk""#), None),

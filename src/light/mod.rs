@@ -39,7 +39,7 @@ pub use beam::BeamLight;
 pub use disk::DiskLight;
 pub use distant::DistantLight;
 pub use emit::EmissionSample;
-pub use environment::{EnvironmentLight, MAX_MAP_TEXELS};
+pub use environment::{EnvironmentLight, MAX_MAP_TEXELS, SUN_SHARE, SUN_SOLID_ANGLE};
 pub use point::PointLight;
 pub use sphere::SphereLight;
 pub use spot::SpotLight;

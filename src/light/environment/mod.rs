@@ -94,7 +94,21 @@ pub struct EnvironmentLight {
     pub scene_center: Vec3,
     /// See `scene_center`.
     pub scene_radius: f32,
+    /// A sun lights the scene: the sky's, or a map's peak ([`SUN_SHARE`]).
+    sun: bool,
 }
+
+/// A map has a sun when its brightest texels that hold this share of its power
+/// (`∫ mean L dω`) span at most [`SUN_SOLID_ANGLE`]: then, as under the sky's sun,
+/// its caustics through specular surfaces are found by light subpaths aimed from
+/// it, hardly by camera paths, and `auto` picks `caustics` (measured on
+/// `scenes/environment.ron`, whose sun holds 60% of the power in 0.05 sr:
+/// docs/integrators.md). A broad map (a uniform one: half its power in half the
+/// sphere) keeps path tracing, where aiming from everywhere costs more than it finds.
+pub const SUN_SHARE: f64 = 0.5;
+
+/// The largest solid angle (steradians) of a map's sun: 1% of the sphere.
+pub const SUN_SOLID_ANGLE: f64 = 4.0 * std::f64::consts::PI / 100.0;
 
 /// Where the radiance comes from.
 #[derive(Clone, Debug)]
@@ -107,12 +121,60 @@ enum Source {
     Sky(Box<SkyEnv>),
 }
 
+/// Whether a map has a sun ([`SUN_SHARE`], [`SUN_SOLID_ANGLE`]), in one pass over its
+/// texels: a histogram of their power and solid angle by radiance, in steps of a
+/// quarter octave below the brightest, read from the top until it holds the share.
+/// Texels within a step count together, so the solid angle found is at most one
+/// step's worth more than the exact (sorted) one: a map on the edge may be called
+/// sunless, never the other way by more than that step.
+struct SunFinder {
+    /// log2 of the brightest texel's mean radiance.
+    top: f32,
+    /// Power and solid angle per step.
+    bins: Vec<(f64, f64)>,
+}
+
+/// Quarter-octave steps of the [`SunFinder`]'s histogram (the last takes everything dimmer).
+const SUN_STEPS: usize = 4 * 40;
+
+impl SunFinder {
+    fn new(mean: &[f32]) -> SunFinder {
+        let max = mean.iter().fold(0.0f32, |m, &x| m.max(x));
+        SunFinder { top: max.log2(), bins: vec![(0.0, 0.0); SUN_STEPS] }
+    }
+
+    fn add(&mut self, radiance: f32, solid: f32) {
+        if radiance > 0.0 {
+            let step = ((self.top - radiance.log2()) * 4.0).max(0.0) as usize;
+            let bin = &mut self.bins[step.min(SUN_STEPS - 1)];
+            bin.0 += (radiance * solid) as f64;
+            bin.1 += solid as f64;
+        }
+    }
+
+    fn found(&self) -> bool {
+        let total: f64 = self.bins.iter().map(|b| b.0).sum();
+        let mut power = 0.0;
+        let mut solid = 0.0;
+        for &(p, s) in &self.bins {
+            power += p;
+            solid += s;
+            if power >= SUN_SHARE * total {
+                return solid <= SUN_SOLID_ANGLE;
+            }
+        }
+        false
+    }
+}
+
 impl EnvironmentLight {
     /// True for the Hosek-Wilkie sky, whose sun (half a degree across) lights
-    /// the scene almost as a delta light does: caustics of it are found by
-    /// light subpaths, hardly by camera paths.
+    /// the scene almost as a delta light does, and for a map with a sun (its
+    /// brightest texels holding [`SUN_SHARE`] of its power within
+    /// [`SUN_SOLID_ANGLE`]): caustics of it are found by light subpaths, hardly
+    /// by camera paths.
     pub fn has_sun(&self) -> bool {
-        matches!(self.source, Source::Sky(_))
+        self.sun
     }
 
     /// Radiance `spectrum` from every direction.
@@ -125,6 +187,7 @@ impl EnvironmentLight {
             from_map: Mat3::IDENTITY,
             scene_center: Vec3::ZERO,
             scene_radius: 1.0,
+            sun: false,
         }
     }
 
@@ -173,6 +236,7 @@ impl EnvironmentLight {
         let mean: Vec<f32> = texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &d65).average()).collect();
         let mut peak = Spectrum::ZERO;
         let mut integral = 0.0f64;
+        let mut sun = SunFinder::new(&mean);
         for j in 0..height {
             let solid = match mapping {
                 EnvMapping::Equirectangular => {
@@ -184,6 +248,7 @@ impl EnvironmentLight {
             for i in 0..width {
                 let k = j * width + i;
                 integral += (mean[k] * solid) as f64;
+                sun.add(mean[k], solid);
                 if mean[k] > 0.0 {
                     let s = emission_spectrum(&texels[k].uplift, texels[k].scale, &d65);
                     peak = Spectrum::from_fn(|b| peak[b].max(s[b]));
@@ -234,6 +299,7 @@ impl EnvironmentLight {
             integral: integral as f32,
             scene_center: Vec3::ZERO,
             scene_radius: 1.0,
+            sun: sun.found(),
         })
     }
     /// The radiance arriving from world direction `wi` (pointing away from the scene).

@@ -125,6 +125,7 @@ impl EnvironmentLight {
             integral: total * scale,
             scene_center: Vec3::ZERO,
             scene_radius: 1.0,
+            sun: true,
         })
     }
 }
