@@ -95,14 +95,30 @@ impl EnvMap {
     /// equirectangular maps wrap around in `i` and clamp `j` at the poles; the
     /// equal-area square folds over its edges onto the texels that border the
     /// same directions (pbrt-v4's `WrapMode::OctahedralSphere`).
-    #[inline]
+    #[inline(always)]
     pub(super) fn texel_index(&self, i: i64, j: i64) -> usize {
         let (w, h) = (self.width as i64, self.height as i64);
         let (i, j) = match self.mapping {
-            EnvMapping::Equirectangular => (i.rem_euclid(w), j.clamp(0, h - 1)),
+            EnvMapping::Equirectangular => (wrap(i, w), j.clamp(0, h - 1)),
             EnvMapping::EqualArea => fold_square(i, j, w, h),
         };
         j as usize * self.width + i as usize
+    }
+}
+
+/// `i.rem_euclid(w)` without a division where `i` is at most one turn
+/// beyond `[0, w)` (a bilinear lookup's columns are in `[-1, w]`): an
+/// integer division was most of a lookup's texel indexing.
+#[inline(always)]
+pub(super) fn wrap(i: i64, w: i64) -> i64 {
+    if (0..w).contains(&i) {
+        i
+    } else if (-w..0).contains(&i) {
+        i + w
+    } else if (w..2 * w).contains(&i) {
+        i - w
+    } else {
+        i.rem_euclid(w)
     }
 }
 

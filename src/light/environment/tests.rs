@@ -295,3 +295,17 @@ fn equal_area_constant_maps_and_continuity_across_the_folds() {
         }
     }
 }
+
+/// `map::wrap` is `rem_euclid` for every column, inside the image, one turn
+/// beyond either edge (its fast paths) and further out (its fallback).
+#[test]
+fn wrapping_columns_is_rem_euclid() {
+    for w in [1i64, 2, 3, 128] {
+        for i in (-3 * w - 2)..=(3 * w + 2) {
+            assert_eq!(map::wrap(i, w), i.rem_euclid(w), "i {i}, w {w}");
+        }
+        for i in [i64::MIN, i64::MIN + 1, i64::MAX, -w - 1, 2 * w] {
+            assert_eq!(map::wrap(i, w), i.rem_euclid(w), "i {i}, w {w}");
+        }
+    }
+}
