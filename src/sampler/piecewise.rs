@@ -22,6 +22,10 @@ pub struct Piecewise1D {
     integral: f64,
     /// The number of cells `n`, as `f64`.
     n: f64,
+    /// `1 / n` where `n` is a power of two, else 0: dividing by a power of
+    /// two and multiplying by its (exact) inverse round the same real number,
+    /// so both give the same bits, and a product does not wait for a divider.
+    inv_n: f64,
     /// A guide table over the buckets of `g(x) = min(⌊x · n⌋, n − 1)` (the
     /// product rounded in `f64`, as [`Piecewise1D::bucket_of`] computes it):
     /// `guide[k]` = how many CDF entries have `g(c) < k` (`k` in `0..=n`).
@@ -57,7 +61,8 @@ impl Piecewise1D {
         cdf[n] = 1.0;
         let integral = acc / n as f64;
         let density = func.iter().map(|&f| (f as f64 / integral) as f32).collect();
-        let mut d = Piecewise1D { density, cdf, integral, n: n as f64, guide: Vec::new() };
+        let inv_n = if n.is_power_of_two() { 1.0 / n as f64 } else { 0.0 };
+        let mut d = Piecewise1D { density, cdf, integral, n: n as f64, inv_n, guide: Vec::new() };
         // guide[k] = #{j : g(cdf[j]) < k}: a histogram of g over the CDF, summed.
         let mut guide = vec![0u32; n + 1];
         for &c in &d.cdf {
@@ -101,9 +106,14 @@ impl Piecewise1D {
         let i = (self.count_at_most(u).max(1) - 1).min(n - 1);
         let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
         let du = if hi > lo { ((u - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.5 };
-        let x = ((i as f64 + du) / self.n) as f32;
+        let (x, lo_edge, hi_edge) = if self.inv_n > 0.0 {
+            let inv = self.inv_n as f32;
+            ((i as f64 + du) * self.inv_n, i as f32 * inv, (i + 1) as f32 * inv)
+        } else {
+            ((i as f64 + du) / self.n, i as f32 / n as f32, (i + 1) as f32 / n as f32)
+        };
         // Keep x inside its cell in f32 (so pdf(x) answers the same cell).
-        let x = x.clamp(i as f32 / n as f32, next_below((i + 1) as f32 / n as f32));
+        let x = (x as f32).clamp(lo_edge, next_below(hi_edge));
         (x, self.density[i], i)
     }
 
@@ -222,6 +232,36 @@ mod tests {
                 for u in us {
                     assert_eq!(d.count_at_most(u), d.cdf.partition_point(|&c| c <= u), "n {n}, u {u}");
                 }
+            }
+        }
+    }
+
+    /// `sample` answers, bit for bit, the plain inversion (a search of the
+    /// whole CDF, divisions by `n` and by the weights' integral), for sizes that
+    /// are powers of two (where it multiplies by `1 / n`) and sizes that are not.
+    #[test]
+    fn sampling_is_the_plain_inversion_bit_for_bit() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(5);
+        for n in [1usize, 2, 3, 4, 7, 8, 64, 100, 128, 257, 1024] {
+            let func: Vec<f32> =
+                (0..n).map(|_| if rng.random::<f32>() < 0.3 { 0.0 } else { rng.random::<f32>() * 10.0 }).collect();
+            let Some(d) = Piecewise1D::new(func.clone()) else { continue };
+            let integral = func.iter().map(|&f| f as f64).sum::<f64>() / n as f64;
+            let mut us: Vec<f32> = (0..2000).map(|_| rng.random::<f32>()).collect();
+            us.extend((0..n).map(|k| (k as f32 / n as f32).clamp(0.0, next_below(1.0))));
+            us.extend([0.0, next_below(1.0)]);
+            for u in us {
+                let uf = u as f64;
+                let i = (d.cdf.partition_point(|&c| c <= uf).max(1) - 1).min(n - 1);
+                let (lo, hi) = (d.cdf[i], d.cdf[i + 1]);
+                let du = if hi > lo { ((uf - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.5 };
+                let x = (((i as f64 + du) / n as f64) as f32)
+                    .clamp(i as f32 / n as f32, next_below((i + 1) as f32 / n as f32));
+                let pdf = (func[i] as f64 / integral) as f32;
+                let (gx, gpdf, gi) = d.sample(u);
+                assert_eq!((gx.to_bits(), gpdf.to_bits(), gi), (x.to_bits(), pdf.to_bits(), i), "n {n}, u {u}");
+                assert_eq!(d.pdf(x).to_bits(), pdf.to_bits());
             }
         }
     }

@@ -22,6 +22,11 @@ pub(super) struct EnvMap {
     /// evaluate the sigmoid of four texels each). A lookup without the cache
     /// spent 34% of `environment.ron`'s render time re-evaluating it.
     pub(super) spectra: Vec<Spectrum>,
+    /// With `spectra`: for each bilinear footprint, whose top-left texel is
+    /// column `x0` in `[-1, w)` and row `y0` in `[-1, h)`, whether its four
+    /// texels are one and the same colour (at `(y0 + 1)(w + 1) + x0 + 1`): a
+    /// lookup then reads one flag instead of four texels.
+    pub(super) uniform: Vec<bool>,
     pub(super) dist: Piecewise2D,
     pub(super) d65: Spectrum,
 }
@@ -48,14 +53,19 @@ impl EnvMap {
         let at = |i: i64, j: i64| self.texel_index(i, j);
         let k = [at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)];
         if !self.spectra.is_empty() {
-            let first = self.texels[k[0]];
-            if k.iter().all(|&i| self.texels[i] == first) {
+            let uniform = match self.footprint(x0, y0) {
+                Some(q) => self.uniform[q],
+                None => self.same_texels(k),
+            };
+            if uniform {
                 return self.spectra[k[0]];
             }
+            // A texel of scale 0 has the spectrum 0 (`emission_spectrum`): adding
+            // it changes no bin of the non-negative sum, as skipping it did.
             let wts = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
             let mut s = Spectrum::ZERO;
             for (k, weight) in k.into_iter().zip(wts) {
-                if weight > 0.0 && self.texels[k].scale > 0.0 {
+                if weight > 0.0 {
                     s += self.spectra[k] * weight;
                 }
             }
@@ -82,6 +92,35 @@ impl EnvMap {
 }
 
 impl EnvMap {
+    /// True when the texels at `k` are all the same.
+    #[inline]
+    fn same_texels(&self, k: [usize; 4]) -> bool {
+        let first = self.texels[k[0]];
+        k.iter().all(|&i| self.texels[i] == first)
+    }
+
+    /// The index into `uniform` of the footprint whose top-left texel is
+    /// `(x0, y0)`, if that is in `[-1, w) x [-1, h)`.
+    #[inline]
+    fn footprint(&self, x0: i64, y0: i64) -> Option<usize> {
+        let (w, h) = (self.width as i64, self.height as i64);
+        ((-1..w).contains(&x0) && (-1..h).contains(&y0)).then(|| ((y0 + 1) * (w + 1) + x0 + 1) as usize)
+    }
+
+    /// Keeps every texel's emission spectrum (`spectra`) and which
+    /// footprints have four equal texels (`uniform`).
+    pub(super) fn cache_spectra(&mut self) {
+        self.spectra = self.texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &self.d65)).collect();
+        let (w, h) = (self.width as i64, self.height as i64);
+        self.uniform = (-1..h)
+            .flat_map(|y0| (-1..w).map(move |x0| (x0, y0)))
+            .map(|(x0, y0)| {
+                let at = |i: i64, j: i64| self.texel_index(i, j);
+                self.same_texels([at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)])
+            })
+            .collect();
+    }
+
     /// The map coordinates of a unit direction `m` in the map's frame.
     #[inline]
     pub(super) fn uv_of(&self, m: Vec3) -> Vec2 {
