@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
-use crate::color::{Spectrum, Uplift, emission_spectrum, emission_uplift, fit_rows};
+use crate::color::{Sampled, Spectrum, Uplift, emission_spectrum, emission_uplift, fit_rows};
 use crate::sampler::piecewise::Piecewise2D;
 use crate::scene::desc::EnvMapping;
 
@@ -63,6 +63,14 @@ impl EnvMap {
             // A texel of scale 0 has the spectrum 0 (`emission_spectrum`): adding
             // it changes no bin of the non-negative sum, as skipping it did.
             let wts = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
+            if wts.iter().all(|&w| w > 0.0) {
+                // The loop below with every term added, bin by bin in the same
+                // order (0 + a·w0 + b·w1 + c·w2 + d·w3), written out so that the
+                // sum stays in registers (the loop's went through memory).
+                let [a, b, c, d] = k.map(|k| &self.spectra[k].0);
+                let [w0, w1, w2, w3] = wts;
+                return Sampled(std::array::from_fn(|i| 0.0 + a[i] * w0 + b[i] * w1 + c[i] * w2 + d[i] * w3));
+            }
             let mut s = Spectrum::ZERO;
             for (k, weight) in k.into_iter().zip(wts) {
                 if weight > 0.0 {
