@@ -13,17 +13,27 @@ use glam::Vec2;
 /// A piecewise-constant density over `[0, 1)` with equal cells.
 #[derive(Clone, Debug)]
 pub struct Piecewise1D {
-    /// The cells' weights.
-    func: Vec<f32>,
+    /// Each cell's density `f_i / (Σ f / n)`, rounded to `f32` once at
+    /// construction (what `sample` and `pdf` return: no division per call).
+    density: Vec<f32>,
     /// `cdf[i]` = the probability of the cells before `i` (`cdf[n]` = 1).
     cdf: Vec<f64>,
     /// `Σ f / n`, the integral of the weights over `[0, 1)`.
     integral: f64,
-    /// `guide[k]` = how many CDF entries are at most `k / n` (`k` in `0..=n`):
-    /// the inversion of a `u` in `[k/n, (k+1)/n)` lies between `guide[k]` and
-    /// `guide[k + 1]`, so it searches that stretch only (a guide table; the
-    /// same answer as a search of the whole CDF, a few entries instead of
-    /// `log2 n` unpredictable steps).
+    /// The number of cells `n`, as `f64`.
+    n: f64,
+    /// `1 / n` where `n` is a power of two, else 0: dividing by a power of
+    /// two and multiplying by its (exact) inverse round the same real number,
+    /// so both give the same bits, and a product does not wait for a divider.
+    inv_n: f64,
+    /// A guide table over the buckets of `g(x) = min(⌊x · n⌋, n − 1)` (the
+    /// product rounded in `f64`, as [`Piecewise1D::bucket_of`] computes it):
+    /// `guide[k]` = how many CDF entries have `g(c) < k` (`k` in `0..=n`).
+    /// `g` is monotone, so every entry below `guide[g(u)]` is below `u` and
+    /// every entry from `guide[g(u) + 1]` on is above it: the inversion of `u`
+    /// searches that stretch only (the same answer as a search of the whole
+    /// CDF, a few entries instead of `log2 n` unpredictable steps, and no
+    /// division).
     guide: Vec<u32>,
 }
 
@@ -49,24 +59,34 @@ impl Piecewise1D {
             *c /= acc;
         }
         cdf[n] = 1.0;
-        let guide = (0..=n).map(|k| cdf.partition_point(|&c| c <= bucket(k, n)) as u32).collect();
-        Some(Piecewise1D { func, cdf, integral: acc / n as f64, guide })
+        let integral = acc / n as f64;
+        let density = func.iter().map(|&f| (f as f64 / integral) as f32).collect();
+        let inv_n = if n.is_power_of_two() { 1.0 / n as f64 } else { 0.0 };
+        let mut d = Piecewise1D { density, cdf, integral, n: n as f64, inv_n, guide: Vec::new() };
+        // guide[k] = #{j : g(cdf[j]) < k}: a histogram of g over the CDF, summed.
+        let mut guide = vec![0u32; n + 1];
+        for &c in &d.cdf {
+            guide[d.bucket_of(c) + 1] += 1;
+        }
+        for k in 1..=n {
+            guide[k] += guide[k - 1];
+        }
+        d.guide = guide;
+        Some(d)
+    }
+
+    /// `g(x) = min(⌊x · n⌋, n − 1)`, with `x · n` rounded in `f64` (0 for a
+    /// negative or NaN `x`): monotone in `x`, which is all the guide table needs.
+    #[inline]
+    fn bucket_of(&self, x: f64) -> usize {
+        ((x * self.n) as usize).min(self.density.len() - 1)
     }
 
     /// How many CDF entries are at most `u` (`partition_point` of the whole
     /// CDF), through the guide table.
     #[inline]
     fn count_at_most(&self, u: f64) -> usize {
-        let n = self.func.len();
-        // The bucket holding u: bucket(k) <= u < bucket(k + 1), fixed up where
-        // u · n rounded across an integer.
-        let mut k = ((u * n as f64) as usize).min(n - 1);
-        while k > 0 && u < bucket(k, n) {
-            k -= 1;
-        }
-        while k + 1 < n && u >= bucket(k + 1, n) {
-            k += 1;
-        }
+        let k = self.bucket_of(u);
         let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
         lo + self.cdf[lo..hi].partition_point(|&c| c <= u)
     }
@@ -81,36 +101,34 @@ impl Piecewise1D {
     #[inline]
     pub fn sample(&self, u: f32) -> (f32, f32, usize) {
         let u = u as f64;
-        let n = self.func.len();
+        let n = self.density.len();
         // The last cell whose CDF start is at most u, skipping empty cells.
         let i = (self.count_at_most(u).max(1) - 1).min(n - 1);
         let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
         let du = if hi > lo { ((u - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.5 };
-        let x = ((i as f64 + du) / n as f64) as f32;
+        let (x, lo_edge, hi_edge) = if self.inv_n > 0.0 {
+            let inv = self.inv_n as f32;
+            ((i as f64 + du) * self.inv_n, i as f32 * inv, (i + 1) as f32 * inv)
+        } else {
+            ((i as f64 + du) / self.n, i as f32 / n as f32, (i + 1) as f32 / n as f32)
+        };
         // Keep x inside its cell in f32 (so pdf(x) answers the same cell).
-        let x = x.clamp(i as f32 / n as f32, next_below((i + 1) as f32 / n as f32));
-        let pdf = (self.func[i] as f64 / self.integral) as f32;
-        (x, pdf, i)
+        let x = (x as f32).clamp(lo_edge, next_below(hi_edge));
+        (x, self.density[i], i)
     }
 
     /// The cell holding `x` (clamped into `[0, 1)`).
     #[inline]
     pub fn cell(&self, x: f32) -> usize {
-        let n = self.func.len();
+        let n = self.density.len();
         ((x.max(0.0) * n as f32) as usize).min(n - 1)
     }
 
     /// The density at `x`.
     #[inline]
     pub fn pdf(&self, x: f32) -> f32 {
-        (self.func[self.cell(x)] as f64 / self.integral) as f32
+        self.density[self.cell(x)]
     }
-}
-
-/// The lower edge `k / n` of guide bucket `k`.
-#[inline]
-fn bucket(k: usize, n: usize) -> f64 {
-    k as f64 / n as f64
 }
 
 /// The largest `f32` below `x` (for `x` > 0).
@@ -178,10 +196,15 @@ mod tests {
     use super::*;
     use crate::sampler::Sampler;
 
+    /// `k / n`, where `u · n` crosses an integer (the guide's bucket edges).
+    fn bucket(k: usize, n: usize) -> f64 {
+        k as f64 / n as f64
+    }
+
     /// The guide table answers exactly what a search of the whole CDF does,
     /// for distributions with empty stretches and spikes, at random `u`, at
-    /// every CDF value and bucket edge and their neighbouring floats, and at
-    /// 0 and the largest f32 below 1.
+    /// every CDF value and bucket edge `k / n` and their neighbouring floats,
+    /// and at 0 and the largest f32 below 1.
     #[test]
     fn the_guide_table_inverts_as_the_whole_search_does() {
         use rand::{RngExt, SeedableRng};
@@ -209,6 +232,36 @@ mod tests {
                 for u in us {
                     assert_eq!(d.count_at_most(u), d.cdf.partition_point(|&c| c <= u), "n {n}, u {u}");
                 }
+            }
+        }
+    }
+
+    /// `sample` answers, bit for bit, the plain inversion (a search of the
+    /// whole CDF, divisions by `n` and by the weights' integral), for sizes that
+    /// are powers of two (where it multiplies by `1 / n`) and sizes that are not.
+    #[test]
+    fn sampling_is_the_plain_inversion_bit_for_bit() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(5);
+        for n in [1usize, 2, 3, 4, 7, 8, 64, 100, 128, 257, 1024] {
+            let func: Vec<f32> =
+                (0..n).map(|_| if rng.random::<f32>() < 0.3 { 0.0 } else { rng.random::<f32>() * 10.0 }).collect();
+            let Some(d) = Piecewise1D::new(func.clone()) else { continue };
+            let integral = func.iter().map(|&f| f as f64).sum::<f64>() / n as f64;
+            let mut us: Vec<f32> = (0..2000).map(|_| rng.random::<f32>()).collect();
+            us.extend((0..n).map(|k| (k as f32 / n as f32).clamp(0.0, next_below(1.0))));
+            us.extend([0.0, next_below(1.0)]);
+            for u in us {
+                let uf = u as f64;
+                let i = (d.cdf.partition_point(|&c| c <= uf).max(1) - 1).min(n - 1);
+                let (lo, hi) = (d.cdf[i], d.cdf[i + 1]);
+                let du = if hi > lo { ((uf - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.5 };
+                let x = (((i as f64 + du) / n as f64) as f32)
+                    .clamp(i as f32 / n as f32, next_below((i + 1) as f32 / n as f32));
+                let pdf = (func[i] as f64 / integral) as f32;
+                let (gx, gpdf, gi) = d.sample(u);
+                assert_eq!((gx.to_bits(), gpdf.to_bits(), gi), (x.to_bits(), pdf.to_bits(), i), "n {n}, u {u}");
+                assert_eq!(d.pdf(x).to_bits(), pdf.to_bits());
             }
         }
     }

@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
-use crate::color::{Spectrum, Uplift, emission_spectrum, emission_uplift, fit_rows};
+use crate::color::{Sampled, Spectrum, Uplift, emission_spectrum, emission_uplift, fit_rows};
 use crate::sampler::piecewise::Piecewise2D;
 use crate::scene::desc::EnvMapping;
 
@@ -22,6 +22,11 @@ pub(super) struct EnvMap {
     /// evaluate the sigmoid of four texels each). A lookup without the cache
     /// spent 34% of `environment.ron`'s render time re-evaluating it.
     pub(super) spectra: Vec<Spectrum>,
+    /// With `spectra`: for each bilinear footprint, whose top-left texel is
+    /// column `x0` in `[-1, w)` and row `y0` in `[-1, h)`, whether its four
+    /// texels are one and the same colour (at `(y0 + 1)(w + 1) + x0 + 1`): a
+    /// lookup then reads one flag instead of four texels.
+    pub(super) uniform: Vec<bool>,
     pub(super) dist: Piecewise2D,
     pub(super) d65: Spectrum,
 }
@@ -48,14 +53,27 @@ impl EnvMap {
         let at = |i: i64, j: i64| self.texel_index(i, j);
         let k = [at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)];
         if !self.spectra.is_empty() {
-            let first = self.texels[k[0]];
-            if k.iter().all(|&i| self.texels[i] == first) {
+            let uniform = match self.footprint(x0, y0) {
+                Some(q) => self.uniform[q],
+                None => self.same_texels(k),
+            };
+            if uniform {
                 return self.spectra[k[0]];
             }
+            // A texel of scale 0 has the spectrum 0 (`emission_spectrum`): adding
+            // it changes no bin of the non-negative sum, as skipping it did.
             let wts = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
+            if wts.iter().all(|&w| w > 0.0) {
+                // The loop below with every term added, bin by bin in the same
+                // order (0 + a·w0 + b·w1 + c·w2 + d·w3), written out so that the
+                // sum stays in registers (the loop's went through memory).
+                let [a, b, c, d] = k.map(|k| &self.spectra[k].0);
+                let [w0, w1, w2, w3] = wts;
+                return Sampled(std::array::from_fn(|i| 0.0 + a[i] * w0 + b[i] * w1 + c[i] * w2 + d[i] * w3));
+            }
             let mut s = Spectrum::ZERO;
             for (k, weight) in k.into_iter().zip(wts) {
-                if weight > 0.0 && self.texels[k].scale > 0.0 {
+                if weight > 0.0 {
                     s += self.spectra[k] * weight;
                 }
             }
@@ -82,6 +100,35 @@ impl EnvMap {
 }
 
 impl EnvMap {
+    /// True when the texels at `k` are all the same.
+    #[inline]
+    fn same_texels(&self, k: [usize; 4]) -> bool {
+        let first = self.texels[k[0]];
+        k.iter().all(|&i| self.texels[i] == first)
+    }
+
+    /// The index into `uniform` of the footprint whose top-left texel is
+    /// `(x0, y0)`, if that is in `[-1, w) x [-1, h)`.
+    #[inline]
+    fn footprint(&self, x0: i64, y0: i64) -> Option<usize> {
+        let (w, h) = (self.width as i64, self.height as i64);
+        ((-1..w).contains(&x0) && (-1..h).contains(&y0)).then(|| ((y0 + 1) * (w + 1) + x0 + 1) as usize)
+    }
+
+    /// Keeps every texel's emission spectrum (`spectra`) and which
+    /// footprints have four equal texels (`uniform`).
+    pub(super) fn cache_spectra(&mut self) {
+        self.spectra = self.texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &self.d65)).collect();
+        let (w, h) = (self.width as i64, self.height as i64);
+        self.uniform = (-1..h)
+            .flat_map(|y0| (-1..w).map(move |x0| (x0, y0)))
+            .map(|(x0, y0)| {
+                let at = |i: i64, j: i64| self.texel_index(i, j);
+                self.same_texels([at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)])
+            })
+            .collect();
+    }
+
     /// The map coordinates of a unit direction `m` in the map's frame.
     #[inline]
     pub(super) fn uv_of(&self, m: Vec3) -> Vec2 {
@@ -95,14 +142,30 @@ impl EnvMap {
     /// equirectangular maps wrap around in `i` and clamp `j` at the poles; the
     /// equal-area square folds over its edges onto the texels that border the
     /// same directions (pbrt-v4's `WrapMode::OctahedralSphere`).
-    #[inline]
+    #[inline(always)]
     pub(super) fn texel_index(&self, i: i64, j: i64) -> usize {
         let (w, h) = (self.width as i64, self.height as i64);
         let (i, j) = match self.mapping {
-            EnvMapping::Equirectangular => (i.rem_euclid(w), j.clamp(0, h - 1)),
+            EnvMapping::Equirectangular => (wrap(i, w), j.clamp(0, h - 1)),
             EnvMapping::EqualArea => fold_square(i, j, w, h),
         };
         j as usize * self.width + i as usize
+    }
+}
+
+/// `i.rem_euclid(w)` without a division where `i` is at most one turn
+/// beyond `[0, w)` (a bilinear lookup's columns are in `[-1, w]`): an
+/// integer division was most of a lookup's texel indexing.
+#[inline(always)]
+pub(super) fn wrap(i: i64, w: i64) -> i64 {
+    if (0..w).contains(&i) {
+        i
+    } else if (-w..0).contains(&i) {
+        i + w
+    } else if (w..2 * w).contains(&i) {
+        i - w
+    } else {
+        i.rem_euclid(w)
     }
 }
 

@@ -267,6 +267,7 @@ impl EnvironmentLight {
             mapping,
             texels,
             spectra: Vec::new(),
+            uniform: Vec::new(),
             dist: Piecewise2D::new(&[1.0], 1, 1).expect("one cell"),
             d65,
         };
@@ -289,7 +290,7 @@ impl EnvironmentLight {
         env.dist = Piecewise2D::new(&weights, width, height)
             .ok_or_else(|| "the map's sampling density is zero or not finite".to_string())?;
         if env.texels.len() <= CACHED_TEXELS {
-            env.spectra = env.texels.iter().map(|t| emission_spectrum(&t.uplift, t.scale, &d65)).collect();
+            env.cache_spectra();
         }
         Ok(EnvironmentLight {
             source: Source::Map(Box::new(env)),

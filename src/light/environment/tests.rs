@@ -295,3 +295,71 @@ fn equal_area_constant_maps_and_continuity_across_the_folds() {
         }
     }
 }
+
+/// `map::wrap` is `rem_euclid` for every column, inside the image, one turn
+/// beyond either edge (its fast paths) and further out (its fallback).
+#[test]
+fn wrapping_columns_is_rem_euclid() {
+    for w in [1i64, 2, 3, 128] {
+        for i in (-3 * w - 2)..=(3 * w + 2) {
+            assert_eq!(map::wrap(i, w), i.rem_euclid(w), "i {i}, w {w}");
+        }
+        for i in [i64::MIN, i64::MIN + 1, i64::MAX, -w - 1, 2 * w] {
+            assert_eq!(map::wrap(i, w), i.rem_euclid(w), "i {i}, w {w}");
+        }
+    }
+}
+
+/// A lookup through the cached spectra and footprint flags gives, bit for
+/// bit, the plain bilinear blend of the four texels' spectra (one texel's
+/// spectrum exactly where all four are the same colour, texels of scale 0
+/// skipped), on a map of blocks of one colour, black texels and random
+/// colours, at random (u, v) and at the edges and poles.
+#[test]
+fn cached_lookups_are_the_plain_bilinear_blend() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(11);
+    let (w, h) = (12usize, 7usize);
+    let rgb: Vec<[f32; 3]> = (0..w * h)
+        .map(|k| match (k % w, k / w) {
+            (i, _) if i < 4 => [0.2, 0.3, 0.5],
+            (i, j) if i >= 10 && j >= 3 => [0.0; 3],
+            _ => [rng.random::<f32>(), rng.random::<f32>(), rng.random::<f32>() * 3.0],
+        })
+        .collect();
+    let env = EnvironmentLight::map(w, h, &rgb, 1.0, Mat3::IDENTITY).unwrap();
+    let Source::Map(m) = &env.source else { panic!("a map") };
+    assert!(!m.spectra.is_empty());
+    let mut uvs: Vec<Vec2> = (0..4000).map(|_| Vec2::new(rng.random::<f32>(), rng.random::<f32>())).collect();
+    for u in [0.0, 0.5 / w as f32, 1.0 - f32::EPSILON] {
+        for v in [0.0, 0.5 / h as f32, 0.5, 1.0 - f32::EPSILON] {
+            uvs.push(Vec2::new(u, v));
+        }
+    }
+    for uv in uvs {
+        let x = uv.x * w as f32 - 0.5;
+        let y = uv.y * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let at = |i: i64, j: i64| (j.clamp(0, h as i64 - 1) as usize) * w + i.rem_euclid(w as i64) as usize;
+        let k = [at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1)];
+        let spectrum = |k: usize| emission_spectrum(&m.texels[k].uplift, m.texels[k].scale, &d65());
+        let want = if k.iter().all(|&i| m.texels[i] == m.texels[k[0]]) {
+            spectrum(k[0])
+        } else {
+            let wts = [(1.0 - fx) * (1.0 - fy), fx * (1.0 - fy), (1.0 - fx) * fy, fx * fy];
+            let mut s = Spectrum::ZERO;
+            for (k, weight) in k.into_iter().zip(wts) {
+                if weight > 0.0 && m.texels[k].scale > 0.0 {
+                    s += spectrum(k) * weight;
+                }
+            }
+            s
+        };
+        let got = m.radiance(uv);
+        for b in 0..crate::color::N_BINS {
+            assert_eq!(got[b].to_bits(), want[b].to_bits(), "uv {uv}, bin {b}");
+        }
+    }
+}
