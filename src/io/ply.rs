@@ -420,6 +420,16 @@ fn append(out: &mut PlyData, parts: Vec<Option<PlyData>>) -> bool {
     if parts.iter().any(Option::is_none) {
         return false;
     }
+    // The whole arrays at once: growing them part by part copied each several times.
+    let total = |len: fn(&PlyData) -> usize| parts.iter().flatten().map(len).sum::<usize>();
+    out.positions.reserve_exact(total(|p| p.positions.len()));
+    out.triangles.reserve_exact(total(|p| p.triangles.len()));
+    if let Some(o) = out.normals.as_mut() {
+        o.reserve_exact(total(|p| p.normals.as_ref().map_or(0, Vec::len)));
+    }
+    if let Some(o) = out.uvs.as_mut() {
+        o.reserve_exact(total(|p| p.uvs.as_ref().map_or(0, Vec::len)));
+    }
     for part in parts.into_iter().flatten() {
         out.positions.extend_from_slice(&part.positions);
         out.triangles.extend_from_slice(&part.triangles);

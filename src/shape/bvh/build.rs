@@ -20,6 +20,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use super::Node;
+use super::hint::advise_huge_pages;
 use crate::geometry::Aabb;
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
@@ -140,9 +141,18 @@ pub(super) fn build_tree(
 ) -> (Vec<Node>, Vec<u32>) {
     assert!(n < INDEX_BIT as usize, "{n} primitives: at most 2^30 - 1 are supported");
     let prim = |i: usize| BuildPrim::new(prim_bounds(i), i as u32);
-    let mut prims: Vec<BuildPrim> =
-        if n > limits.threshold { (0..n).into_par_iter().map(prim).collect() } else { (0..n).map(prim).collect() };
+    // The build's two big arrays (28 MB of primitives for the full dragon) are advised
+    // before their first touch, so that it maps 2 MiB pages: a quarter fewer page faults
+    // for the whole load, 0.33 s instead of 0.35-0.36 s on one thread (docs/performance.md).
+    let mut prims: Vec<BuildPrim> = Vec::with_capacity(n);
+    advise_huge_pages(prims.spare_capacity_mut());
+    if n > limits.threshold {
+        (0..n).into_par_iter().map(prim).collect_into_vec(&mut prims);
+    } else {
+        prims.extend((0..n).map(prim));
+    }
     let mut nodes = Vec::with_capacity(prims.len() * 2 / 3 + 1);
+    advise_huge_pages(nodes.spare_capacity_mut());
     if !prims.is_empty() {
         let (bounds, centroids) = node_bounds(&prims, limits.threshold);
         build_node(&mut prims, bounds, centroids, 0, 0, &mut nodes, limits);
