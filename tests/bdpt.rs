@@ -13,7 +13,7 @@ use rust_v::film::Film;
 use rust_v::scene::{load_scene, load_scene_str};
 use rust_v::settings::{IntegratorKind, SettingsPatch};
 
-use crate::common::{render_into, render_str, root, seeded_blocks, square_settings};
+use crate::common::{assert_threads_and_merge_exact, render_into, render_str, root, seeded_blocks, square_settings};
 
 /// The expected falloff at a floor point, given `cos θ` from the light (None: skip the pixel).
 type Falloff = Box<dyn Fn(f64) -> Option<f64>>;
@@ -404,25 +404,7 @@ fn bdpt_is_deterministic_and_merges_exactly() {
     for integrator in [IntegratorKind::Bdpt, IntegratorKind::LightTrace] {
         let o = square_settings(integrator, 24, 6, 5);
         let scene = load_scene_str(&text, &root().join("scenes/caustic-point.ron"), &o).unwrap();
-        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-        let whole1 = one.install(|| {
-            let mut f = Film::new(24, 24);
-            render_into(&scene, &mut f, 0..6);
-            f
-        });
-        let whole2 = two.install(|| {
-            let mut f = Film::new(24, 24);
-            render_into(&scene, &mut f, 0..6);
-            f
-        });
-        assert_eq!(whole1, whole2, "{integrator:?}: 1 vs 2 threads");
-        let mut a = Film::new(24, 24);
-        render_into(&scene, &mut a, 0..3);
-        let mut b = Film::starting_at(24, 24, 3);
-        render_into(&scene, &mut b, 3..6);
-        a.merge(&b).unwrap();
-        assert_eq!(a, whole1, "{integrator:?}: merged halves");
+        let whole1 = assert_threads_and_merge_exact(&scene, 24, 6, &format!("{integrator:?}"));
         assert!(whole1.mean_xyz().iter().any(|p| p[1] > 0.0));
     }
 }

@@ -8,7 +8,7 @@ use rust_v::film::Film;
 use rust_v::scene::load_scene_str;
 use rust_v::settings::IntegratorKind;
 
-use crate::common::{render_into, render_str, root, seeded_blocks, square_settings};
+use crate::common::{assert_threads_and_merge_exact, render_into, render_str, root, seeded_blocks, square_settings};
 
 /// Asserts every block of `a` within 4.5 combined standard errors (+1e-4)
 /// of `b`'s (16 blocks: all pass by chance with probability > 99.9%), and
@@ -193,23 +193,7 @@ fn caustics_is_deterministic_and_merges_exactly() {
     let text = glass_over_floor("lights: [ Distant(direction: (0.25, -1, -0.3), irradiance: Constant(3)) ],");
     let scene =
         load_scene_str(&text, &root().join("t.ron"), &square_settings(IntegratorKind::Caustics, 24, 6, 5)).unwrap();
-    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-    let whole = |pool: &rayon::ThreadPool| {
-        pool.install(|| {
-            let mut f = Film::new(24, 24);
-            render_into(&scene, &mut f, 0..6);
-            f
-        })
-    };
-    let (whole1, whole2) = (whole(&one), whole(&two));
-    assert_eq!(whole1, whole2, "1 vs 2 threads");
-    let mut a = Film::new(24, 24);
-    render_into(&scene, &mut a, 0..3);
-    let mut b = Film::starting_at(24, 24, 3);
-    render_into(&scene, &mut b, 3..6);
-    a.merge(&b).unwrap();
-    assert_eq!(a, whole1, "merged halves");
+    let whole1 = assert_threads_and_merge_exact(&scene, 24, 6, "caustics");
     // The light side splatted something: the image differs from path tracing's.
     let path = load_scene_str(&text, &root().join("t.ron"), &square_settings(IntegratorKind::Path, 24, 6, 5)).unwrap();
     let mut p = Film::new(24, 24);

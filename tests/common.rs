@@ -153,13 +153,41 @@ pub fn seeded_blocks(
     let runs: Vec<Vec<f64>> = (0..seeds)
         .map(|s| block_means(&render_str(text, &square_settings(integrator, size, spp, 100 + s)), 4))
         .collect();
-    let n = seeds as f64;
-    let stats = |v: &[f64]| {
-        let m = v.iter().sum::<f64>() / n;
-        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    seed_stats(&runs)
+}
+
+/// Renders passes `0..passes` of `scene` on a `size`² film on 1 and on 2 threads, and as
+/// the merge of `0..passes/2` and `passes/2..passes`; asserts the three films are the same
+/// (bit for bit: `what` names the case) and returns it.
+pub fn assert_threads_and_merge_exact(scene: &rust_v::scene::Scene, size: u32, passes: u32, what: &str) -> Film {
+    let whole = |threads: usize| {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
+            let mut f = Film::new(size, size);
+            render_into(scene, &mut f, 0..passes);
+            f
+        })
+    };
+    let (whole1, whole2) = (whole(1), whole(2));
+    assert_eq!(whole1, whole2, "{what}: 1 vs 2 threads");
+    let half = passes / 2;
+    let mut a = Film::new(size, size);
+    render_into(scene, &mut a, 0..half);
+    let mut b = Film::starting_at(size, size, half);
+    render_into(scene, &mut b, half..passes);
+    a.merge(&b).unwrap();
+    assert_eq!(a, whole1, "{what}: merged halves");
+    whole1
+}
+
+/// Mean and standard error over the runs (one vector of block means per seed) of
+/// each block, and of each run's sum over its blocks.
+pub fn seed_stats(runs: &[Vec<f64>]) -> (Vec<(f64, f64)>, (f64, f64)) {
+    let n = runs.len() as f64;
+    let stats = |v: &dyn Fn(&Vec<f64>) -> f64| {
+        let m = runs.iter().map(v).sum::<f64>() / n;
+        let var = runs.iter().map(|r| (v(r) - m).powi(2)).sum::<f64>() / (n - 1.0);
         (m, (var / n).sqrt())
     };
-    let blocks = (0..runs[0].len()).map(|k| stats(&runs.iter().map(|r| r[k]).collect::<Vec<_>>())).collect();
-    let sums: Vec<f64> = runs.iter().map(|r| r.iter().sum()).collect();
-    (blocks, stats(&sums))
+    let blocks = (0..runs[0].len()).map(|k| stats(&|r| r[k])).collect();
+    (blocks, stats(&|r| r.iter().sum()))
 }

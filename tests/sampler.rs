@@ -12,7 +12,7 @@ use rust_v::render::{Limits, render};
 use rust_v::scene::{Scene, load_scene, load_scene_str};
 use rust_v::settings::{IntegratorKind, SamplerKind, SettingsPatch};
 
-use crate::common::{block_means, root, rust_v, temp_dir};
+use crate::common::{block_means, root, rust_v, seed_stats, temp_dir};
 
 fn patch(integrator: IntegratorKind, sampler: SamplerKind, size: u32, seed: u64) -> SettingsPatch {
     SettingsPatch {
@@ -109,14 +109,7 @@ fn seeded_blocks(
             block_means(&f, 4)
         })
         .collect();
-    let n = seeds as f64;
-    let stats = |v: &dyn Fn(&Vec<f64>) -> f64| {
-        let m = runs.iter().map(v).sum::<f64>() / n;
-        let var = runs.iter().map(|r| (v(r) - m).powi(2)).sum::<f64>() / (n - 1.0);
-        (m, (var / n).sqrt())
-    };
-    let blocks = (0..runs[0].len()).map(|k| stats(&|r| r[k])).collect();
-    (blocks, stats(&|r| r.iter().sum()))
+    seed_stats(&runs)
 }
 
 /// Unbiased at 1 spp: on the Cornell box (path tracing, `auto`) and the caustic scene

@@ -90,7 +90,7 @@ use glam::{Vec2, Vec3};
 use crate::film::Splat;
 use crate::geometry::{Frame, Ray};
 use crate::light::EmissionSample;
-use crate::sampler::warp::{concentric_disk, uniform_sphere};
+use crate::sampler::warp::{concentric_disk, cone_one_minus_cos, uniform_sphere};
 use crate::sampler::{Dim, Sampler};
 use crate::scene::Scene;
 use crate::spectral::Contribution;
@@ -227,10 +227,7 @@ impl Aim {
         let dir = if d2 <= r2 {
             uniform_sphere(Vec2::new(ux, u.y))
         } else {
-            // 1 − cos θ_max without cancellation: sin² / (1 + cos).
-            let sin2 = r2 / d2;
-            let one_minus = sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt());
-            let v = ux * one_minus;
+            let v = ux * cone_one_minus_cos(r2 / d2);
             let (cos, sin) = (1.0 - v, (v * (2.0 - v)).max(0.0).sqrt());
             let phi = 2.0 * PI * u.y;
             Frame::from_z(d / d2.sqrt()).to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)).normalize()
@@ -258,9 +255,7 @@ impl Aim {
                 if along <= 0.0 || (d - dir * along).length_squared() > r2 * (1.0 + 1e-4) {
                     return 0.0;
                 }
-                let sin2 = r2 / d2;
-                let one_minus = sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt());
-                t.p / (2.0 * PI * one_minus)
+                t.p / (2.0 * PI * cone_one_minus_cos(r2 / d2))
             })
             .sum()
     }

@@ -17,7 +17,7 @@ use super::{EmissionTexture, LightSample, mean_radiance, sides};
 use crate::color::Spectrum;
 use crate::geometry::Frame;
 use crate::geometry::Hit;
-use crate::sampler::warp::{cos_sin_2pi, uniform_sphere};
+use crate::sampler::warp::{cone_one_minus_cos, cos_sin_2pi, uniform_sphere};
 use crate::shape::{Shape, Sphere};
 
 /// A spherical area light emitting `radiance` outward (and inward too when two-sided).
@@ -128,15 +128,6 @@ fn by_area(d2: f32, r2: f32) -> bool {
 /// The relative band of squared distance around the sphere treated as on it
 /// (1e-4: points within 5e-5 radii; hit points lie within about 1e-6).
 const ON_SPHERE: f32 = 1e-4;
-
-/// `1 − cos θmax` of the cone a sphere subtends, from `sin² θmax = r² / d²`,
-/// as `sin² / (1 + cos)`: exact to rounding at any size, where `1 − sqrt(1 − sin²)`
-/// loses every digit once the light is smaller than about 1e-3 of its distance.
-#[inline]
-fn cone_one_minus_cos(sin2_max: f32) -> f32 {
-    let sin2 = sin2_max.min(1.0);
-    sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt())
-}
 
 /// Emission sampling: rays leaving the light (BDPT's light subpaths, light tracing).
 impl SphereLight {

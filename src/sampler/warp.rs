@@ -68,6 +68,15 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) * FRAC_1_PI
 }
 
+/// `1 − cos θmax` of the cone a sphere subtends, from `sin² θmax = r² / d²`,
+/// as `sin² / (1 + cos)`: exact to rounding at any size, where `1 − sqrt(1 − sin²)`
+/// loses every digit once the sphere is smaller than about 1e-3 of its distance.
+#[inline]
+pub fn cone_one_minus_cos(sin2_max: f32) -> f32 {
+    let sin2 = sin2_max.min(1.0);
+    sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt())
+}
+
 /// Uniform direction on the unit sphere.
 #[inline]
 pub fn uniform_sphere(u: Vec2) -> Vec3 {
