@@ -176,6 +176,12 @@ impl Dielectric {
         }
     }
 
+    /// GGX α (0 for a smooth interface).
+    #[inline]
+    pub fn roughness(&self) -> f32 {
+        self.alpha
+    }
+
     /// True when the interface is smooth (a delta model).
     #[inline]
     pub fn is_smooth(&self) -> bool {

@@ -47,6 +47,13 @@ mod tests_rough;
 mod thin_film;
 
 pub use conductor::Conductor;
+
+/// The largest GGX α of a glossy lobe ([`Bxdf::is_glossy`]). At α = 0.08 (the
+/// gold of `scenes/environment.ron`) the sun's reflection onto the floor was
+/// half of `caustics`' error as camera paths found it (fireflies where a
+/// diffuse bounce happened to hit the gold and then the sun); light subpaths
+/// aimed at the gold find it at every subpath.
+pub const GLOSSY_ALPHA: f32 = 0.1;
 pub use dielectric::{Dielectric, Outside};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, refract};
 pub use ior::{Ior, NAMED_GLASSES, named_glass};
@@ -253,6 +260,31 @@ impl Bxdf {
             Bxdf::Dielectric(d) => Some(d),
             _ => None,
         }
+    }
+
+    /// True for a glossy lobe: a rough conductor or rough dielectric (one
+    /// microfacet lobe) with GGX α at most [`GLOSSY_ALPHA`]. `--integrator
+    /// caustics` gives the caustics such a lobe casts to its light side, as
+    /// those of a delta lobe (`crate::integrator::caustics`).
+    #[inline]
+    pub fn is_glossy(&self) -> bool {
+        match self {
+            Bxdf::Conductor(c) => !c.is_smooth() && c.alpha <= GLOSSY_ALPHA,
+            Bxdf::Dielectric(d) => !d.is_smooth() && d.roughness() <= GLOSSY_ALPHA,
+            _ => false,
+        }
+    }
+
+    /// True when a hit on this material may be glossy ([`Bxdf::is_glossy`]):
+    /// it is glossy, or its roughness is a texture (`textured_roughness`) on a
+    /// rough conductor or dielectric, whose value at some hit may be.
+    pub fn may_be_glossy(&self, textured_roughness: bool) -> bool {
+        let rough = match self {
+            Bxdf::Conductor(c) => !c.is_smooth(),
+            Bxdf::Dielectric(d) => !d.is_smooth(),
+            _ => false,
+        };
+        self.is_glossy() || (textured_roughness && rough)
     }
 
     /// True when the model's directions are all delta (no light sampling pays).

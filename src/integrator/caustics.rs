@@ -4,46 +4,61 @@
 //!
 //! # A partition of path space
 //! Write a path `E X1 X2 … Xk L` (`E` the eye, `X1` the first vertex seen
-//! from the camera, `Xk` the last before the light). The **light side** owns
-//! the paths with `k ≥ 2` whose `X1` scattered through a non-delta lobe,
-//! whose `Xk` scattered through a delta lobe (smooth glass, mirror, smooth
-//! metal, thin sheet, a smooth Plastic's coat) and whose light `L` is
+//! from the camera, `Xk` the last before the light). Call a vertex's
+//! scattering *specular* when it went through a delta lobe (smooth glass,
+//! mirror, smooth metal, thin sheet, a smooth Plastic's coat) or off a
+//! glossy surface (a rough conductor or rough glass of GGX α at most
+//! [`crate::bxdf::GLOSSY_ALPHA`], [`crate::bxdf::Bxdf::is_glossy`], decided at
+//! each hit: a roughness texture may make some hits glossy and others not),
+//! and *diffuse* otherwise. The **light side** owns the paths with `k ≥ 2`
+//! whose `X1` is diffuse, whose `Xk` is specular and whose light `L` is
 //! *aimed*: the environment (map, uniform or sky with its sun), a distant
-//! light, a point or a spot light. The **camera side** owns every other path. Each camera sample adds
-//! the two estimates:
+//! light, a point or a spot light. The **camera side** owns every other
+//! path. Each camera sample adds the two estimates:
 //!
 //! - the camera side is `auto`'s path tracer ([`PathTracer`] with
-//!   `light_caustics`): an escape to the environment through a delta lobe on
-//!   a path whose first vertex scattered through a non-delta lobe adds 0.
-//!   Next-event estimation never goes through a delta lobe, so it is
-//!   untouched; distant, point and spot lights are never hit by a camera
-//!   path (today's `path` simply misses their caustics);
+//!   `light_caustics`): on a path whose first vertex is diffuse, an escape
+//!   to the environment through a delta lobe or off a glossy surface adds 0,
+//!   and so does a glossy surface's next-event estimate when it picks an
+//!   aimed light (MIS's two strategies for that vertex and light both go:
+//!   the light side takes the whole). Next-event estimation never goes
+//!   through a delta lobe; distant, point and spot lights are never hit by a
+//!   camera path (today's `path` simply misses their caustics);
 //! - the light side is, with probability [`Caustics::fraction`] per camera
 //!   sample (its splats weighted by the inverse: 1/16 where every aimed ray
-//!   reaches a delta surface, more where fewer do, [`Aim::reach`]), one light subpath
-//!   ([`Bdpt::caustic_splats`]): an
+//!   reaches a surface that may cast caustics, more where fewer do,
+//!   [`Aim::reach`]), one light subpath ([`Bdpt::caustic_splats`]): an
 //!   aimed light chosen by power among the aimed lights ([`Aim::choose_light`]),
-//!   a ray aimed at the bounding spheres of the objects with a delta lobe
-//!   ([`Aim::aimed_ray`]): for a parallel bundle its direction as the light
-//!   draws it and its origin on one of the disks that cover the spheres,
-//!   perpendicular to the direction and upstream of the scene
-//!   ([`Aim::sample_origin`]); for a point or spot light its position and a
-//!   direction uniform in one sphere's cone ([`Aim::sample_direction`]). If its first surface vertex `y1` did not scatter
-//!   through a delta lobe, the subpath ends (that path is the camera side's);
-//!   otherwise every later vertex `y_i`, `i ≥ 2`, is connected to the eye
-//!   with weight 1 (no MIS) and splatted, as `lighttrace`'s are. The path
-//!   `E y_i … y1 y0` then has `X1 = y_i` (non-delta: a connection evaluates
-//!   only the non-delta part of its BSDF), `Xk = y1` (delta) and `k = i ≥ 2`:
-//!   exactly the light side's paths, each made once.
+//!   a ray aimed at the bounding spheres of the objects that may cast
+//!   caustics ([`Scene::may_cast_caustics`]; [`Aim::aimed_ray`]): for a
+//!   parallel bundle its direction as the light draws it and its origin on
+//!   one of the disks that cover the spheres, perpendicular to the direction
+//!   and upstream of the scene ([`Aim::sample_origin`]); for a point or spot
+//!   light its position and a direction uniform in one sphere's cone
+//!   ([`Aim::sample_direction`]). If its first surface vertex `y1`'s
+//!   scattering is not specular, the subpath ends (that path is the camera
+//!   side's); otherwise every later vertex `y_i`, `i ≥ 2`, that is not
+//!   glossy is connected to the eye with weight 1 (no MIS) and splatted, as
+//!   `lighttrace`'s are. The path `E y_i … y1 y0` then has `X1 = y_i`
+//!   (diffuse: a connection evaluates only the non-delta part of its BSDF),
+//!   `Xk = y1` (specular) and `k = i ≥ 2`: exactly the light side's paths,
+//!   each made once.
 //!
 //! Both sides are unbiased estimators of their parts of the measurement
 //! (their sampling densities are positive wherever the parts are nonzero:
-//! every ray of an aimed light that reaches a delta object passes through
+//! every ray of an aimed light that reaches a specular object passes through
 //! that object's disk), so their sum is unbiased by linearity, with no MIS
 //! weights. A material with a delta and a non-delta lobe (Plastic) splits the
 //! same way per lobe: the camera side keeps its non-delta lobe's paths
 //! (next-event estimation and the MIS-weighted escape), the light side its
-//! delta lobe's.
+//! delta lobe's. A glossy surface has one lobe, all of it specular.
+//!
+//! Why glossy surfaces too: on `scenes/environment.ron` (gold of α 0.08) a
+//! camera path found the sun's reflection in the gold onto the floor only
+//! when a diffuse bounce happened to hit the gold and its light sample then
+//! the sun through the narrow lobe: rare samples of about 250 times a floor
+//! pixel's value. Aimed light subpaths land there at every try
+//! (docs/performance.md, "Glossy caustics to the light side").
 //!
 //! # Aiming
 //! From a point or spot light the direction's density per solid angle is
@@ -71,12 +86,14 @@
 //!
 //! # Limits
 //! Paths whose first bounce from the light is diffuse stay with the camera
-//! side (the caustic seen in a mirror, say, is the camera side's); area
+//! side (the caustic seen in a mirror, say, is the camera side's); so do
+//! those whose `X1` is glossy (the floor's caustic seen in the gold): a
+//! connection to the eye through a narrow lobe would rarely count; area
 //! lights and beams are not aimed (their caustics stay as `path` finds
 //! them: none for a beam); an object with a
-//! delta lobe and no bounds (a mirror plane) leaves no disk to aim at, and
-//! then `caustics` is path tracing alone, as it is without a delta surface
-//! or an aimed light. Scenes with scattering media are refused at load.
+//! delta lobe or a glossy surface and no bounds (a mirror plane) leaves no
+//! disk to aim at, and then `caustics` is path tracing alone, as it is
+//! without a specular surface or an aimed light. Scenes with scattering media are refused at load.
 //!
 //! [`Dim::wavelength`]: crate::sampler::Dim::wavelength
 //! [`Dim::EMIT_CHOICE`]: crate::sampler::Dim::EMIT_CHOICE
@@ -97,7 +114,7 @@ use crate::spectral::Contribution;
 
 use super::{Bdpt, Estimator, FullSpectrum, PathTracer};
 
-/// A disk to aim at: the bounding sphere of an object with a delta lobe.
+/// A disk to aim at: the bounding sphere of an object that may cast caustics.
 #[derive(Clone, Copy, Debug)]
 struct Target {
     center: Vec3,
@@ -124,9 +141,9 @@ pub(crate) struct Aim {
 
 impl Aim {
     /// The aim for `scene`, or `None` when there is nothing to aim (no aimed
-    /// light with power, no object with a delta lobe, or an unbounded one).
+    /// light with power, no object that may cast caustics, or an unbounded one).
     pub(crate) fn new(scene: &Scene) -> Option<Aim> {
-        let spheres = scene.delta_targets()?;
+        let spheres = scene.caustic_targets()?;
         let spheres: Vec<(Vec3, f32)> =
             spheres.into_iter().filter(|(c, r)| c.is_finite() && r.is_finite() && *r > 0.0).collect();
         let lights: Vec<(u32, f32)> = (0..scene.light_count() as u32)
@@ -186,7 +203,7 @@ impl Aim {
             let Some((index, _)) = self.choose_light(u_light) else { continue };
             let Some(e) = self.aimed_ray(scene, index, u_pos, u_dir) else { continue };
             if let Some(si) = scene.intersect(&Ray::spawn(e.point, e.n, e.dir), f32::INFINITY)
-                && scene.may_scatter_delta(si.object)
+                && scene.may_cast_caustics(si.object)
             {
                 hits += 1;
             }
@@ -316,7 +333,7 @@ impl Aim {
 }
 
 /// The share of camera samples that also trace a light subpath when every
-/// aimed ray reaches a delta surface (their splats are weighted by the
+/// aimed ray reaches a surface that may cast caustics (their splats are weighted by the
 /// inverse of the share: unbiased); [`Aim::reach`] raises it where fewer do. On
 /// `scenes/environment.ron` at 192x128 (32 spp, one thread, against a
 /// 4096-spp reference) MSE × time relative to `path`'s was 1.19 with a
@@ -324,7 +341,9 @@ impl Aim {
 /// 1/16, 0.45 at 1/32, 0.46 at 1/64: the light subpaths cost as much as the
 /// camera paths, and one per 16 camera samples already takes the caustic's
 /// error far below the rest of the image's (85% of the aimed rays reach the
-/// glass there, so [`Caustics::new`] traces a light subpath for 7.4%).
+/// glass there, so [`Caustics::new`] traces a light subpath for 7.4%). With
+/// the gold's glossy caustics aimed at too (8 renders of 16 spp each), 1/8
+/// and 1/4 gave 3% and 4% less error than 1/16 for 23% and 48% more time.
 const LIGHT_FRACTION: f32 = 1.0 / 16.0;
 
 /// How many aimed rays [`Aim::reach`] traces.
@@ -341,7 +360,7 @@ pub(crate) struct Caustics {
     pub aim: Aim,
     /// The probability that a camera sample traces a light subpath:
     /// [`LIGHT_FRACTION`] divided by [`Aim::reach`], at most 1 (1 when no
-    /// pilot ray reached a delta surface), so that about one camera sample
+    /// pilot ray reached a surface that may cast caustics), so that about one camera sample
     /// in 16 has a light subpath that reaches one.
     pub fraction: f32,
 }

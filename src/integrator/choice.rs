@@ -141,7 +141,7 @@ pub fn describe(scene: &Scene) -> String {
 /// The line for `caustics` (also `auto`'s where it picks it).
 fn describe_caustics(scene: &Scene, c: &Caustics) -> String {
     format!(
-        "auto's path tracing, except caustics of the environment and distant, point and spot lights through specular surfaces: light subpaths aimed at {} specular object(s) ({:.0}% of aimed rays reach one; a light subpath for {:.1}% of the samples) connect them to the camera (no MIS: a partition of the paths)",
+        "auto's path tracing, except caustics of the environment and distant, point and spot lights through specular and glossy surfaces: light subpaths aimed at {} specular or glossy object(s) ({:.0}% of aimed rays reach one; a light subpath for {:.1}% of the samples) connect them to the camera (no MIS: a partition of the paths)",
         c.aim.target_count(),
         100.0 * c.aim.reach(scene),
         100.0 * c.fraction

@@ -357,7 +357,9 @@ pub(crate) fn interface<'a>(scene: &'a Scene, media: &mut VolumeStack, si: &Surf
 /// point on it sampled by solid angle or area, a shadow ray through
 /// [`Scene::transmittance`] (from the volumes the path is in, `volumes`, on the
 /// side the light is), and the MIS weight against BSDF sampling (power
-/// heuristic) when `mis` is set. Its numbers are the draws of depth `depth`.
+/// heuristic) when `mis` is set. Without `aimed`, a light `caustics` aims
+/// (`crate::light::Light::can_be_aimed`) adds nothing: at a glossy surface whose
+/// caustics its light side traces. Its numbers are the draws of depth `depth`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn sample_direct<const N: usize>(
@@ -369,6 +371,7 @@ pub(crate) fn sample_direct<const N: usize>(
     lambdas: &Lambdas<N>,
     sampler: &mut Sampler,
     mis: bool,
+    aimed: bool,
     depth: u32,
 ) -> Sampled<N> {
     let zero = Sampled::splat(0.0);
@@ -377,6 +380,9 @@ pub(crate) fn sample_direct<const N: usize>(
     let Some(choice) = scene.sample_li(sh.p, u_light, u) else {
         return zero;
     };
+    if !aimed && scene.light(choice.light).can_be_aimed() {
+        return zero;
+    }
     let ls = choice.sample;
     let wi_local = sh.frame.to_local(ls.wi);
     if !sh.consistent(ls.wi, wi_local) {

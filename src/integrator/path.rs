@@ -76,11 +76,12 @@ pub struct PathTracer {
     /// refracts at a dispersive surface (`auto`); packets smaller than the
     /// full spectrum split into all their wavelengths.
     pub collapse_to: u32,
-    /// `--integrator caustics`' camera side: an escape to the environment
-    /// through a delta lobe, on a path whose first vertex scattered through a
-    /// non-delta lobe, adds nothing (light subpaths aimed at the specular
-    /// surfaces carry those paths: `super::caustics`). False for every
-    /// other integrator.
+    /// `--integrator caustics`' camera side: on a path whose first vertex
+    /// scattered through a lobe neither delta nor glossy, an escape to the
+    /// environment through a delta lobe or off a glossy surface, and a glossy
+    /// surface's light sample of an aimed light, add nothing (light subpaths
+    /// aimed at the specular and glossy surfaces carry those paths:
+    /// `super::caustics`). False for every other integrator.
     pub light_caustics: bool,
 }
 
@@ -90,6 +91,9 @@ struct Prev {
     p: glam::Vec3,
     pdf_bsdf: f32,
     delta: bool,
+    /// The surface scattered off is glossy ([`crate::bxdf::Bxdf::is_glossy`];
+    /// only looked at for a path `caustics`' light side may own, [`Walk::owned`]).
+    glossy: bool,
 }
 
 /// The state of a walk between vertices.
@@ -103,8 +107,9 @@ struct Walk<const N: usize> {
     /// The dielectric media the path is inside.
     media: VolumeStack,
     /// The light side of `caustics` owns this path's escapes through a delta
-    /// lobe: [`PathTracer::light_caustics`] is set and the first vertex
-    /// scattered through a non-delta lobe.
+    /// lobe or off a glossy surface, and a glossy surface's light samples of
+    /// aimed lights: [`PathTracer::light_caustics`] is set and the first
+    /// vertex scattered through a lobe neither delta nor glossy.
     owned: bool,
 }
 
@@ -130,7 +135,7 @@ impl PathTracer {
             beta: Sampled::splat(1.0),
             eta_scale: 1.0,
             bounces: 0,
-            prev: Prev { p: ray.origin, pdf_bsdf: 0.0, delta: true },
+            prev: Prev { p: ray.origin, pdf_bsdf: 0.0, delta: true, glossy: false },
             media: scene.camera_volumes,
             owned: false,
         };
@@ -272,7 +277,8 @@ impl PathTracer {
             }
             // 4. Direct light.
             if !bxdf.is_delta() {
-                l += w.beta * sample_direct(scene, bxdf, &sh, &at, &w.media, lambdas, sampler, true, w.bounces);
+                let aimed = !(w.owned && bxdf.is_glossy());
+                l += w.beta * sample_direct(scene, bxdf, &sh, &at, &w.media, lambdas, sampler, true, aimed, w.bounces);
             }
             // 5. The next direction.
             let (reads_u, reads_uc) = bxdf.reads_draws();
@@ -293,11 +299,12 @@ impl PathTracer {
             at.scattered(&mut w.media, ray.dir, hit.n, wi);
             w.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
             w.eta_scale *= bs.eta * bs.eta;
+            let glossy = self.light_caustics && bxdf.is_glossy();
             if w.bounces == 0 {
-                w.owned = self.light_caustics && !bs.is_delta;
+                w.owned = self.light_caustics && !bs.is_delta && !glossy;
             }
             w.bounces += 1;
-            w.prev = Prev { p: hit.p, pdf_bsdf: bs.pdf, delta: bs.is_delta };
+            w.prev = Prev { p: hit.p, pdf_bsdf: bs.pdf, delta: bs.is_delta, glossy };
             if w.beta.is_black() {
                 break;
             }
@@ -444,7 +451,7 @@ impl PathTracer {
         *l += w.beta * super::sample_direct_medium(scene, phase, p, wo, &w.media, lambdas, sampler, w.bounces);
         let (wi, pdf) = phase.sample(wo, sampler.get_2d(Dim::bsdf(w.bounces)));
         w.bounces += 1;
-        w.prev = Prev { p, pdf_bsdf: pdf, delta: false };
+        w.prev = Prev { p, pdf_bsdf: pdf, delta: false, glossy: false };
         if w.bounces >= RR_DEPTH {
             let q = (w.beta.max_value() * w.eta_scale).min(1.0);
             if sampler.get_1d_if(q < 1.0, Dim::roulette(w.bounces - 1)) >= q {
@@ -467,10 +474,11 @@ impl PathTracer {
 /// MIS-weighted against the light sample taken at the previous vertex (zero
 /// without an environment, or when the path is inside an absorbing medium:
 /// an infinite segment there transmits nothing; zero too for a path `caustics`'
-/// light side owns, [`Walk::owned`], that escapes through a delta lobe).
+/// light side owns, [`Walk::owned`], that escapes through a delta lobe or off a
+/// glossy surface).
 #[inline]
 fn escape<const N: usize>(scene: &Scene, ray: &Ray, w: &Walk<N>, lambdas: &Lambdas<N>) -> Sampled<N> {
-    if w.owned && w.prev.delta {
+    if w.owned && (w.prev.delta || w.prev.glossy) {
         // `caustics`: the light side's path (see `Walk::owned`).
         return Sampled::splat(0.0);
     }

@@ -84,7 +84,7 @@ impl Whitted {
             let sh = Shading::new(hit.p, hit.n, hit.ns, ray.dir);
             if !bxdf.is_delta() {
                 // The diffuse end of E S* D L: direct light only, then stop.
-                l += beta * sample_direct(scene, bxdf, &sh, &at, &media, lambdas, sampler, false, bounces);
+                l += beta * sample_direct(scene, bxdf, &sh, &at, &media, lambdas, sampler, false, true, bounces);
                 break;
             }
             let (reads_u, reads_uc) = bxdf.reads_draws();

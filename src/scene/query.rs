@@ -236,16 +236,14 @@ impl Scene {
         })
     }
 
-    /// The bounding spheres `(centre, radius)` of the objects that may scatter
-    /// through a delta lobe ([`Bxdf::has_delta_lobe`] of any material a hit on
-    /// them may have; an index-matched `Interface` does not count, as in
-    /// [`Scene::has_delta_surface`]): where `--integrator caustics` aims its
-    /// light subpaths. Instances and meshes by their world bounds. `None`
-    /// when such an object is unbounded (no sphere holds it).
-    pub fn delta_targets(&self) -> Option<Vec<(Vec3, f32)>> {
+    /// The bounding spheres `(centre, radius)` of the objects that may cast
+    /// caustics ([`Scene::may_cast_caustics`]): where `--integrator caustics`
+    /// aims its light subpaths. Instances and meshes by their world bounds.
+    /// `None` when such an object is unbounded (no sphere holds it).
+    pub fn caustic_targets(&self) -> Option<Vec<(Vec3, f32)>> {
         let mut targets = Vec::new();
         for (i, o) in self.objects.iter().enumerate() {
-            if self.may_scatter_delta(i as u32) {
+            if self.may_cast_caustics(i as u32) {
                 // A sphere is its own bounding sphere (its box's is √3 times as wide).
                 if let crate::shape::Shape::Sphere(s) = &o.shape {
                     targets.push((s.center, s.radius));
@@ -259,11 +257,16 @@ impl Scene {
     }
 
     /// True when a hit on object `object` may scatter through a delta lobe
-    /// ([`Bxdf::has_delta_lobe`] of any material it may have; not an `Interface`).
-    pub fn may_scatter_delta(&self, object: u32) -> bool {
+    /// ([`Bxdf::has_delta_lobe`] of any material it may have; an index-matched
+    /// `Interface` does not count, as in [`Scene::has_delta_surface`]) or a
+    /// glossy one ([`Bxdf::may_be_glossy`]): the surfaces whose caustics
+    /// `--integrator caustics` traces from the lights.
+    pub fn may_cast_caustics(&self, object: u32) -> bool {
         self.leaves(&self.objects[object as usize].material).iter().any(|&m| {
+            let textured_roughness =
+                self.textures.get(m as usize).is_some_and(|t| t.as_ref().is_some_and(|t| t.roughness.is_some()));
             let m = &self.materials[m as usize];
-            m.has_delta_lobe() && !m.is_interface()
+            (m.has_delta_lobe() && !m.is_interface()) || m.may_be_glossy(textured_roughness)
         })
     }
 

@@ -248,9 +248,10 @@ impl Bdpt {
     /// `caustics`' light side for one camera sample: one aimed light subpath
     /// (its wavelength draw `u_λ` from [`Dim::wavelength`]`(1)`, which the
     /// camera side never draws), and, when its first surface vertex
-    /// scattered through a delta lobe, every later vertex `y_i`, `i ≥ 2`,
-    /// connected to the eye (`t = 1`, weight 1, as `lighttrace`'s: `self`
-    /// is `light_only`) and splatted to `splats`, scaled by `weight`.
+    /// scattered through a delta lobe or is glossy, every later vertex `y_i`,
+    /// `i ≥ 2`, that is not glossy connected to the eye (`t = 1`, weight 1, as
+    /// `lighttrace`'s: `self` is `light_only`) and splatted to `splats`,
+    /// scaled by `weight`.
     pub(crate) fn caustic_splats<O: Contribution>(
         &self,
         scene: &Scene,
@@ -270,13 +271,17 @@ impl Bdpt {
             let track = scene.has_volumes();
             let mut wl = Wavelength { u: sampler.get_1d(Dim::wavelength(1)), continuous: O::CONTINUOUS, drawn: None };
             self.light_subpath(scene, Some(aim), sampler, light, track.then_some(&mut *light_media), &mut wl);
-            if light.len() < 3 || !light[1].delta {
+            if light.len() < 3 || !(light[1].delta || light[1].glossy) {
                 return;
             }
             let full = Lambdas::full();
             let max = self.max_bounces as usize;
             let (camera, light) = (Sub { v: camera, media: camera_media }, Sub { v: light, media: light_media });
             for s in 3..=light.v.len().min(max + 1) {
+                // A glossy `y_i` seen from the eye is the camera side's (its `X1`).
+                if light.v[s - 1].glossy {
+                    continue;
+                }
                 if let Some((pixel, c)) = self.connect_camera(scene, light, s, camera, sampler, &mut wl) {
                     let value = match c {
                         Contrib::Full(c) => O::from_packet(&scene.sensor, &full, &(c * weight)),

@@ -68,6 +68,7 @@ fn walk(scene: &Scene, path: &mut Vec<Vertex>, mut pdf_dir: f32, points: &[Point
             sh: Shading::new(q.p, q.n, q.n, arrival),
             beta: Spectrum::ONE,
             delta: false,
+            glossy: false,
             collapsed: false,
             pdf_fwd: 0.0,
             pdf_rev: 0.0,

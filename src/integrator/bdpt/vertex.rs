@@ -37,6 +37,8 @@ pub(super) struct Vertex {
     pub(super) beta: Spectrum,
     /// The scattering sampled here was a delta lobe.
     pub(super) delta: bool,
+    /// The surface here is glossy ([`crate::bxdf::Bxdf::is_glossy`]).
+    pub(super) glossy: bool,
     /// The subpath collapsed to one wavelength before reaching this vertex.
     pub(super) collapsed: bool,
     /// Area density of this vertex as its own walk generated it.
@@ -69,6 +71,7 @@ impl Vertex {
             sh,
             beta,
             delta: false,
+            glossy: false,
             collapsed: false,
             pdf_fwd,
             pdf_rev: 0.0,
@@ -250,6 +253,7 @@ pub(super) fn medium_vertex(object: u32, p: Vec3, dir: Vec3, beta: Spectrum, col
         sh,
         beta,
         delta: false,
+        glossy: false,
         collapsed,
         pdf_fwd: 0.0,
         pdf_rev: 0.0,

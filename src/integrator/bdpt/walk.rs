@@ -19,7 +19,7 @@ pub(super) struct Walk {
     /// The most vertices the subpath may have, its first included.
     pub(super) max_vertices: usize,
     /// End the subpath at its first surface vertex unless that vertex
-    /// scattered through a delta lobe (`caustics`' light side).
+    /// scattered through a delta lobe or is glossy (`caustics`' light side).
     pub(super) delta_first: bool,
 }
 
@@ -167,6 +167,7 @@ impl Walk {
                 sh,
                 beta,
                 delta: false,
+                glossy: bxdf.is_glossy(),
                 collapsed,
                 pdf_fwd: 0.0,
                 pdf_rev: 0.0,
@@ -231,7 +232,7 @@ impl Walk {
             let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf_within(bs.wi, sh.wo, &full, out)) };
             let n = path.len();
             path[n - 1].delta = bs.is_delta;
-            if self.delta_first && n == 2 && !bs.is_delta {
+            if self.delta_first && n == 2 && !bs.is_delta && !path[1].glossy {
                 break;
             }
             path[n - 2].pdf_rev = rev * path[n - 1].g_prev;
