@@ -179,6 +179,35 @@ fn a_glossy_panels_caustic_is_counted_once() {
     assert_blocks_agree("a glossy panel under a uniform environment, caustics vs path", &caustics, &path);
 }
 
+/// A glossy gold `Plane` (unbounded: no disk to aim at) as a back wall
+/// behind a glass sphere on a diffuse floor, lit by a point light: the
+/// plane's glossy caustics stay the camera side's and the glass is still
+/// aimed at (the light side splats: the image is not `path`'s), and
+/// `caustics` agrees with BDPT block by block. (A point light: BDPT's
+/// subpaths from a distant light start on a disk around the bounded scene
+/// and miss the plane beyond it.)
+#[test]
+fn an_unbounded_glossy_plane_leaves_the_glass_aimed() {
+    let text = r#"(
+        camera: (eye: (0, 1.3, 2.6), look_at: (0, 0.25, 0), fov_deg: 45),
+        render: (max_bounces: 8),
+        materials: { "glass": Dielectric(ior: Constant(1.5)), "floor": Lambertian(reflectance: Constant(0.7)),
+                     "gold": Conductor(metal: "Au", roughness: 0.05) },
+        objects: [
+            (shape: Quad(origin: (-3, 0, 3), edge_u: (6, 0, 0), edge_v: (0, 0, -6)), material: "floor"),
+            (shape: Sphere(center: (0, 0.75, 0), radius: 0.5), material: "glass"),
+            (shape: Plane(point: (0, 0, -1.5), normal: (0, 0, 1)), material: "gold"),
+        ],
+        lights: [ Point(position: (0.3, 2.2, 0.2), intensity: Constant(4)) ],
+    )"#;
+    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 16, 24).0;
+    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
+    assert_blocks_agree("a glossy plane behind the glass, caustics vs bdpt", &caustics, &bdpt);
+    let path = render_str(text, &square_settings(IntegratorKind::Path, 16, 4, 3));
+    let light_side = render_str(text, &square_settings(IntegratorKind::Caustics, 16, 4, 3));
+    assert_ne!(light_side, path, "caustics rendered as path: the glass was not aimed at");
+}
+
 /// A wall with a hole between a distant light and the glass sphere: most
 /// aimed rays hit the wall, so a light subpath is traced for more of the
 /// samples (and weighted less); `caustics` still agrees with BDPT block by

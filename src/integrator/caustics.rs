@@ -10,7 +10,9 @@
 //! glossy surface (a rough conductor or rough glass of GGX α at most
 //! [`crate::bxdf::GLOSSY_ALPHA`], [`crate::bxdf::Bxdf::is_glossy`], decided at
 //! each hit: a roughness texture may make some hits glossy and others not),
-//! and *diffuse* otherwise. The **light side** owns the paths with `k ≥ 2`
+//! and *diffuse* otherwise; as a last vertex `Xk` a glossy surface counts as
+//! specular only on a bounded object ([`Scene::glossy_at`]: a glossy `Plane`
+//! has no disk to aim at). The **light side** owns the paths with `k ≥ 2`
 //! whose `X1` is diffuse, whose `Xk` is specular and whose light `L` is
 //! *aimed*: the environment (map, uniform or sky with its sun), a distant
 //! light, a point or a spot light. The **camera side** owns every other
@@ -91,9 +93,10 @@
 //! connection to the eye through a narrow lobe would rarely count; area
 //! lights and beams are not aimed (their caustics stay as `path` finds
 //! them: none for a beam); an object with a
-//! delta lobe or a glossy surface and no bounds (a mirror plane) leaves no
-//! disk to aim at, and then `caustics` is path tracing alone, as it is
-//! without a specular surface or an aimed light. Scenes with scattering media are refused at load.
+//! delta lobe and no bounds (a mirror plane) leaves no disk to aim at, and
+//! then `caustics` is path tracing alone, as it is without a specular
+//! surface or an aimed light; a glossy `Plane`'s caustics stay the camera
+//! side's and the other targets keep theirs. Scenes with scattering media are refused at load.
 //!
 //! [`Dim::wavelength`]: crate::sampler::Dim::wavelength
 //! [`Dim::EMIT_CHOICE`]: crate::sampler::Dim::EMIT_CHOICE

@@ -91,7 +91,7 @@ struct Prev {
     p: glam::Vec3,
     pdf_bsdf: f32,
     delta: bool,
-    /// The surface scattered off is glossy ([`crate::bxdf::Bxdf::is_glossy`];
+    /// The surface scattered off is glossy ([`Scene::glossy_at`];
     /// only looked at for a path `caustics`' light side may own, [`Walk::owned`]).
     glossy: bool,
 }
@@ -277,7 +277,7 @@ impl PathTracer {
             }
             // 4. Direct light.
             if !bxdf.is_delta() {
-                let aimed = !(w.owned && bxdf.is_glossy());
+                let aimed = !(w.owned && scene.glossy_at(si.object, bxdf));
                 l += w.beta * sample_direct(scene, bxdf, &sh, &at, &w.media, lambdas, sampler, true, aimed, w.bounces);
             }
             // 5. The next direction.
@@ -299,9 +299,9 @@ impl PathTracer {
             at.scattered(&mut w.media, ray.dir, hit.n, wi);
             w.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
             w.eta_scale *= bs.eta * bs.eta;
-            let glossy = self.light_caustics && bxdf.is_glossy();
+            let glossy = self.light_caustics && scene.glossy_at(si.object, bxdf);
             if w.bounces == 0 {
-                w.owned = self.light_caustics && !bs.is_delta && !glossy;
+                w.owned = self.light_caustics && !bs.is_delta && !bxdf.is_glossy();
             }
             w.bounces += 1;
             w.prev = Prev { p: hit.p, pdf_bsdf: bs.pdf, delta: bs.is_delta, glossy };

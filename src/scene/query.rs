@@ -259,15 +259,29 @@ impl Scene {
     /// True when a hit on object `object` may scatter through a delta lobe
     /// ([`Bxdf::has_delta_lobe`] of any material it may have; an index-matched
     /// `Interface` does not count, as in [`Scene::has_delta_surface`]) or a
-    /// glossy one ([`Bxdf::may_be_glossy`]): the surfaces whose caustics
-    /// `--integrator caustics` traces from the lights.
+    /// glossy one ([`Bxdf::may_be_glossy`], on a bounded object: see
+    /// [`Scene::glossy_at`]): the surfaces whose caustics `--integrator
+    /// caustics` traces from the lights.
     pub fn may_cast_caustics(&self, object: u32) -> bool {
+        let bounded = self.objects[object as usize].shape.bounds().is_some();
         self.leaves(&self.objects[object as usize].material).iter().any(|&m| {
             let textured_roughness =
                 self.textures.get(m as usize).is_some_and(|t| t.as_ref().is_some_and(|t| t.roughness.is_some()));
             let m = &self.materials[m as usize];
-            (m.has_delta_lobe() && !m.is_interface()) || m.may_be_glossy(textured_roughness)
+            (m.has_delta_lobe() && !m.is_interface()) || (bounded && m.may_be_glossy(textured_roughness))
         })
+    }
+
+    /// True when lobe `bxdf` at a hit on object `object` is glossy and may
+    /// be aimed at, as the last vertex `Xk` of a path in `--integrator
+    /// caustics`' partition: [`Bxdf::is_glossy`] on a bounded object. A
+    /// glossy `Plane` is not (no bounding sphere to aim at): its caustics
+    /// stay the camera side's, and the other targets keep theirs. As a path's
+    /// first vertex `X1` any glossy surface counts (the light side never
+    /// connects the eye to one).
+    #[inline]
+    pub fn glossy_at(&self, object: u32, bxdf: &Bxdf) -> bool {
+        bxdf.is_glossy() && !matches!(self.objects[object as usize].shape, crate::shape::Shape::Plane(_))
     }
 
     /// The emission leaving surface hit `si` back along `dir` (the direction

@@ -248,7 +248,7 @@ impl Bdpt {
     /// `caustics`' light side for one camera sample: one aimed light subpath
     /// (its wavelength draw `u_λ` from [`Dim::wavelength`]`(1)`, which the
     /// camera side never draws), and, when its first surface vertex
-    /// scattered through a delta lobe or is glossy, every later vertex `y_i`,
+    /// scattered through a delta lobe or is glossy on a bounded object, every later vertex `y_i`,
     /// `i ≥ 2`, that is not glossy connected to the eye (`t = 1`, weight 1, as
     /// `lighttrace`'s: `self` is `light_only`) and splatted to `splats`,
     /// scaled by `weight`.

@@ -19,7 +19,8 @@ pub(super) struct Walk {
     /// The most vertices the subpath may have, its first included.
     pub(super) max_vertices: usize,
     /// End the subpath at its first surface vertex unless that vertex
-    /// scattered through a delta lobe or is glossy (`caustics`' light side).
+    /// scattered through a delta lobe or is glossy on a bounded object
+    /// (`Scene::glossy_at`; `caustics`' light side).
     pub(super) delta_first: bool,
 }
 
@@ -232,7 +233,7 @@ impl Walk {
             let (fwd, rev) = if bs.is_delta { (0.0, 0.0) } else { (bs.pdf, bxdf.pdf_within(bs.wi, sh.wo, &full, out)) };
             let n = path.len();
             path[n - 1].delta = bs.is_delta;
-            if self.delta_first && n == 2 && !bs.is_delta && !path[1].glossy {
+            if self.delta_first && n == 2 && !bs.is_delta && !scene.glossy_at(si.object, bxdf) {
                 break;
             }
             path[n - 2].pdf_rev = rev * path[n - 1].g_prev;
