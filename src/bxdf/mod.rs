@@ -47,13 +47,6 @@ mod tests_rough;
 mod thin_film;
 
 pub use conductor::Conductor;
-
-/// The largest GGX α of a glossy lobe ([`Bxdf::is_glossy`]). At α = 0.08 (the
-/// gold of `scenes/environment.ron`) the sun's reflection onto the floor was
-/// half of `caustics`' error as camera paths found it (fireflies where a
-/// diffuse bounce happened to hit the gold and then the sun); light subpaths
-/// aimed at the gold find it at every subpath.
-pub const GLOSSY_ALPHA: f32 = 0.1;
 pub use dielectric::{Dielectric, Outside};
 pub use fresnel::{fresnel_conductor, fresnel_dielectric, refract};
 pub use ior::{Ior, NAMED_GLASSES, named_glass};
@@ -63,6 +56,13 @@ pub use oren_nayar::OrenNayar;
 pub use plastic::Plastic;
 pub use specular::Mirror;
 pub use thin_film::{ThinFilm, ThinSheet, airy};
+
+/// The largest GGX α of a glossy lobe ([`Bxdf::is_glossy`]). At α = 0.08 (the
+/// gold of `scenes/environment.ron`) the sun's reflection onto the floor was
+/// about half of `caustics`' error as camera paths found it (fireflies where a
+/// diffuse bounce happened to hit the gold and then the sun); light subpaths
+/// aimed at the gold find it at every subpath.
+pub const GLOSSY_ALPHA: f32 = 0.1;
 
 use glam::{Vec2, Vec3};
 
