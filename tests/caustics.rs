@@ -30,6 +30,18 @@ fn assert_blocks_agree(what: &str, a: &[(f64, f64)], b: &[(f64, f64)]) {
     assert!((ma - mb).abs() <= 4.5 * se + 1e-5, "{what}: image {ma} vs {mb} (se {se})");
 }
 
+/// Per-block (mean, standard error) over the seeds ([`seeded_blocks`]).
+type Blocks = Vec<(f64, f64)>;
+
+/// `caustics`' blocks and `reference`'s for scene `text` (24 renders each,
+/// 16x16, 16 spp), asserted to agree ([`assert_blocks_agree`]); both returned.
+fn caustics_agrees_with(text: &str, reference: IntegratorKind, what: &str) -> (Blocks, Blocks) {
+    let other = seeded_blocks(text, reference, 16, 16, 24).0;
+    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
+    assert_blocks_agree(what, &caustics, &other);
+    (caustics, other)
+}
+
 /// A smooth glass sphere over a diffuse floor (its focus, 1.5 radii from
 /// its centre for an index of 1.5, on the floor), lit by `light` (a RON line).
 fn glass_over_floor(light: &str) -> String {
@@ -54,9 +66,7 @@ fn glass_over_floor(light: &str) -> String {
 #[test]
 fn caustics_matches_path_under_a_uniform_environment() {
     let text = glass_over_floor("environment: Uniform(Constant(1)),");
-    let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24).0;
-    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("uniform environment, caustics vs path", &caustics, &path);
+    caustics_agrees_with(&text, IntegratorKind::Path, "uniform environment, caustics vs path");
 }
 
 /// Under the sky with its sun (half a degree: path tracing finds its caustic
@@ -67,9 +77,7 @@ fn caustics_matches_bdpt_under_the_sky_with_its_sun() {
     let text = glass_over_floor(
         "environment: Sky(sun_elevation_deg: 50, sun_azimuth_deg: 20, turbidity: 3, ground_albedo: 0.3, scale: 0.05),",
     );
-    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24).0;
-    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("sky with sun, caustics vs bdpt", &caustics, &bdpt);
+    caustics_agrees_with(&text, IntegratorKind::Bdpt, "sky with sun, caustics vs bdpt");
 }
 
 /// A distant light over the glass sphere: path tracing cannot see its
@@ -80,10 +88,8 @@ fn caustics_matches_bdpt_under_the_sky_with_its_sun() {
 #[test]
 fn a_distant_lights_caustic_that_path_tracing_misses() {
     let text = glass_over_floor("lights: [ Distant(direction: (0.25, -1, -0.3), irradiance: Constant(3)) ],");
-    let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24).0;
-    let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
+    let (caustics, bdpt) = caustics_agrees_with(&text, IntegratorKind::Bdpt, "distant light, caustics vs bdpt");
     let path = seeded_blocks(&text, IntegratorKind::Path, 16, 16, 24).0;
-    assert_blocks_agree("distant light, caustics vs bdpt", &caustics, &bdpt);
     let (k, gap) =
         bdpt.iter().zip(&path).map(|(b, p)| b.0 - p.0).enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).unwrap();
     let se = |a: &(f64, f64), b: &(f64, f64)| (a.1 * a.1 + b.1 * b.1).sqrt();
@@ -102,9 +108,7 @@ fn point_and_spot_light_caustics_match_bdpt() {
         "lights: [ Spot(position: (0.3, 2.2, 0.2), look_at: (0, 0, 0), cone_deg: 30, falloff_deg: 10, intensity: Constant(4)) ],",
     ] {
         let text = glass_over_floor(light);
-        let bdpt = seeded_blocks(&text, IntegratorKind::Bdpt, 16, 16, 24).0;
-        let caustics = seeded_blocks(&text, IntegratorKind::Caustics, 16, 16, 24).0;
-        assert_blocks_agree(&format!("{light} caustics vs bdpt"), &caustics, &bdpt);
+        caustics_agrees_with(&text, IntegratorKind::Bdpt, &format!("{light} caustics vs bdpt"));
     }
 }
 
@@ -138,13 +142,13 @@ fn glossy_caustics_go_to_the_light_side_unbiased() {
         )
     };
     let distant = scene("lights: [ Distant(direction: (0.4, -1, -0.5), irradiance: Constant(3)) ],");
-    let bdpt = seeded_blocks(&distant, IntegratorKind::Bdpt, 16, 16, 24).0;
-    let caustics = seeded_blocks(&distant, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("glossy spheres under a distant light, caustics vs bdpt", &caustics, &bdpt);
+    caustics_agrees_with(&distant, IntegratorKind::Bdpt, "glossy spheres under a distant light, caustics vs bdpt");
     let uniform = scene("environment: Uniform(Constant(1)),");
-    let path = seeded_blocks(&uniform, IntegratorKind::Path, 16, 16, 24).0;
-    let caustics = seeded_blocks(&uniform, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("glossy spheres under a uniform environment, caustics vs path", &caustics, &path);
+    caustics_agrees_with(
+        &uniform,
+        IntegratorKind::Path,
+        "glossy spheres under a uniform environment, caustics vs path",
+    );
 }
 
 /// A glossy gold panel (α 0.05) standing on a floor throws a distant light's
@@ -170,13 +174,13 @@ fn a_glossy_panels_caustic_is_counted_once() {
         )
     };
     let distant = scene("lights: [ Distant(direction: (1, -1, 0.1), irradiance: Constant(3)) ],");
-    let bdpt = seeded_blocks(&distant, IntegratorKind::Bdpt, 16, 16, 24).0;
-    let caustics = seeded_blocks(&distant, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("a glossy panel under a distant light, caustics vs bdpt", &caustics, &bdpt);
+    caustics_agrees_with(&distant, IntegratorKind::Bdpt, "a glossy panel under a distant light, caustics vs bdpt");
     let uniform = scene("environment: Uniform(Constant(1)),");
-    let path = seeded_blocks(&uniform, IntegratorKind::Path, 16, 16, 24).0;
-    let caustics = seeded_blocks(&uniform, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("a glossy panel under a uniform environment, caustics vs path", &caustics, &path);
+    caustics_agrees_with(
+        &uniform,
+        IntegratorKind::Path,
+        "a glossy panel under a uniform environment, caustics vs path",
+    );
 }
 
 /// A glossy gold `Plane` (unbounded: no disk to aim at) as a back wall
@@ -200,9 +204,7 @@ fn an_unbounded_glossy_plane_leaves_the_glass_aimed() {
         ],
         lights: [ Point(position: (0.3, 2.2, 0.2), intensity: Constant(4)) ],
     )"#;
-    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 16, 24).0;
-    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("a glossy plane behind the glass, caustics vs bdpt", &caustics, &bdpt);
+    caustics_agrees_with(text, IntegratorKind::Bdpt, "a glossy plane behind the glass, caustics vs bdpt");
     let path = render_str(text, &square_settings(IntegratorKind::Path, 16, 4, 3));
     let light_side = render_str(text, &square_settings(IntegratorKind::Caustics, 16, 4, 3));
     assert_ne!(light_side, path, "caustics rendered as path: the glass was not aimed at");
@@ -227,9 +229,7 @@ fn a_blocked_target_raises_the_rate_and_stays_unbiased() {
         ],
         lights: [ Distant(direction: (0, -1, 0), irradiance: Constant(3)) ],
     )"#;
-    let bdpt = seeded_blocks(text, IntegratorKind::Bdpt, 16, 16, 24).0;
-    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("a roof with a slot, caustics vs bdpt", &caustics, &bdpt);
+    caustics_agrees_with(text, IntegratorKind::Bdpt, "a roof with a slot, caustics vs bdpt");
 }
 
 /// The camera inside a large glass sphere (a target that encloses the eye)
@@ -251,9 +251,7 @@ fn a_target_that_encloses_the_camera() {
         ],
         environment: Uniform(Constant(1)),
     )"#;
-    let path = seeded_blocks(text, IntegratorKind::Path, 16, 16, 24).0;
-    let caustics = seeded_blocks(text, IntegratorKind::Caustics, 16, 16, 24).0;
-    assert_blocks_agree("camera inside a glass dome, caustics vs path", &caustics, &path);
+    caustics_agrees_with(text, IntegratorKind::Path, "camera inside a glass dome, caustics vs path");
 }
 
 /// With nothing to aim at (no specular surface, or no environment or

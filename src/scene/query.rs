@@ -274,14 +274,15 @@ impl Scene {
 
     /// True when lobe `bxdf` at a hit on object `object` is glossy and may
     /// be aimed at, as the last vertex `Xk` of a path in `--integrator
-    /// caustics`' partition: [`Bxdf::is_glossy`] on a bounded object. A
-    /// glossy `Plane` is not (no bounding sphere to aim at): its caustics
+    /// caustics`' partition: [`Bxdf::is_glossy`] on a bounded object (the
+    /// test [`Scene::may_cast_caustics`] makes, so every such object is a
+    /// target). A glossy `Plane` is not (no bounding sphere to aim at): its caustics
     /// stay the camera side's, and the other targets keep theirs. As a path's
     /// first vertex `X1` any glossy surface counts (the light side never
     /// connects the eye to one).
     #[inline]
     pub fn glossy_at(&self, object: u32, bxdf: &Bxdf) -> bool {
-        bxdf.is_glossy() && !matches!(self.objects[object as usize].shape, crate::shape::Shape::Plane(_))
+        bxdf.is_glossy() && self.objects[object as usize].shape.bounds().is_some()
     }
 
     /// The emission leaving surface hit `si` back along `dir` (the direction
